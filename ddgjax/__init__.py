@@ -1,0 +1,25 @@
+"""ddgjax: variational discrete differential geometry in JAX.
+
+Declare a discrete object as an energy with constraints (`Problem`), and get its critical
+points (`solvers.solve`), Euler–Lagrange equations (`euler_lagrange`), flows
+(`gradient_flow`, `hamiltonian_flow`) and smooth limits (`limits.convergence`) by automatic
+differentiation.  Importing ddgjax switches JAX to float64 (the only global setting).
+"""
+
+import jax as _jax
+
+_jax.config.update("jax_enable_x64", True)
+
+from . import errors as errors  # noqa: E402
+from . import limits as limits  # noqa: E402
+from .flows import (  # noqa: E402
+    gradient_flow as gradient_flow,
+    hamiltonian_flow as hamiltonian_flow,
+    integrate as integrate,
+    lie_bracket as lie_bracket,
+    spin_poisson as spin_poisson,
+)
+from .locality import concat as concat, local_map as local_map, local_sum as local_sum  # noqa: E402
+from .problem import Problem as Problem, euler_lagrange as euler_lagrange, lagrangian as lagrangian  # noqa: E402
+
+__version__ = "0.1.0"

@@ -1,0 +1,59 @@
+"""Exceptions raised by ddgjax.
+
+Every error a user can trigger with bad input is a subclass of :class:`DDGError`, and its
+message names the offending element: the pytree leaf and index of a bad value, the vertex,
+edge or face of a bad mesh, the counts that make a problem over-constrained.  The subclasses
+that describe bad *values* also derive from :class:`ValueError`, so generic handlers work.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "DDGError",
+    "InvalidInputError",
+    "NonFiniteError",
+    "ShapeError",
+    "NotScalarError",
+    "OverconstrainedError",
+    "ConvergenceError",
+]
+
+
+class DDGError(Exception):
+    """Base class of every error ddgjax raises on purpose."""
+
+
+class InvalidInputError(DDGError, ValueError):
+    """An argument has the right type but a value the mathematics does not allow."""
+
+
+class NonFiniteError(InvalidInputError):
+    """An input contains NaN or infinity; the message names the leaf and the index."""
+
+
+class ShapeError(InvalidInputError):
+    """An array has the wrong shape, or two pytrees that must match do not."""
+
+
+class NotScalarError(ShapeError):
+    """An energy returned something other than a scalar."""
+
+
+class OverconstrainedError(InvalidInputError):
+    """A problem has more constraints than free unknowns."""
+
+
+class ConvergenceError(DDGError, RuntimeError):
+    """`solve` stopped before the KKT residual reached `tol`.
+
+    **Attributes:**
+    - `residual`: the last (scaled) max-norm KKT residual.
+    - `steps`: the number of steps taken.
+    - `solution`: the last iterate as a `Solution` (not converged), for inspection.
+    """
+
+    def __init__(self, message: str, *, residual: float, steps: int, solution=None):
+        super().__init__(message)
+        self.residual = residual
+        self.steps = steps
+        self.solution = solution

@@ -1,0 +1,12 @@
+"""ddgjax.solvers: the generic constrained critical-point solver.
+
+`solve(problem)` runs globalised Newton on the KKT system of a `ddgjax.Problem` with dense or
+sparse (declared locality) linear algebra, an optional first-order phase, and implicit
+differentiation.  This package knows nothing of curves or meshes.
+"""
+
+import ddgjax as _ddgjax  # noqa: F401  (switches on float64 before anything is traced)
+
+from ._solve import Solution as Solution, solve as solve
+
+__all__ = ["solve", "Solution"]

@@ -1,0 +1,65 @@
+"""First-order phase: the augmented Lagrangian method with L-BFGS inner solves (jaxopt).
+
+For a *minimisation* problem this needs only gradients, so it is cheap per step and robust far
+from the solution; it either solves the problem alone (`method="lbfgs"`) or warm-starts Newton
+(`warm_start="lbfgs"`).  With `L_ρ(u; λ) = E(u) − λ·g(u) + ½ρ|g(u)|²`:
+
+    u ← argmin_u L_ρ(u; λ)          (L-BFGS, jaxopt)
+    λ ← λ − ρ g(u)                   (first-order multiplier update, our sign: ∇E = Jᵀλ)
+    ρ ← 10ρ  if |g| did not shrink by a factor 4
+
+It cannot find saddle points; Newton can.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore", DeprecationWarning)
+    import jaxopt
+
+from ._kkt import KKT, scaled_residual
+
+
+class FirstOrderState(NamedTuple):
+    u: jax.Array
+    lam: jax.Array
+    rho: jax.Array
+    g_norm: jax.Array
+    residual: jax.Array
+    step: jax.Array
+
+
+def augmented_lagrangian(kkt: KKT, w0, weights, *, tol: float, outer_steps: int, inner_steps: int = 500):
+    """Run at most `outer_steps` outer iterations; returns `(w, outer steps taken, residual)`."""
+    n = kkt.spec.n
+
+    def L_rho(u, lam, rho):
+        g = kkt.g(u)
+        return kkt.energy(u) - jnp.dot(lam, g) + 0.5 * rho * jnp.dot(g, g)
+
+    lbfgs = jaxopt.LBFGS(fun=L_rho, maxiter=inner_steps, tol=0.1 * tol, implicit_diff=False)
+
+    def residual_of(u, lam):
+        return scaled_residual(kkt.residual(jnp.concatenate([u, lam])), weights, n)
+
+    def cond(s: FirstOrderState):
+        return (s.residual > tol) & (s.step < outer_steps)
+
+    def body(s: FirstOrderState) -> FirstOrderState:
+        u = lbfgs.run(s.u, s.lam, s.rho).params
+        g = kkt.g(u)
+        lam = s.lam - s.rho * g
+        g_norm = jnp.max(jnp.abs(g)) if g.size else jnp.zeros(())
+        rho = jnp.where(g_norm > 0.25 * s.g_norm, 10.0 * s.rho, s.rho)
+        return FirstOrderState(u, lam, jnp.minimum(rho, 1e8), g_norm, residual_of(u, lam), s.step + 1)
+
+    u0, lam0 = kkt.split(w0)
+    s0 = FirstOrderState(u0, lam0, jnp.asarray(10.0), jnp.asarray(jnp.inf), residual_of(u0, lam0), jnp.asarray(0))
+    s = jax.lax.while_loop(cond, body, s0)
+    return jnp.concatenate([s.u, s.lam]), s.step, s.residual

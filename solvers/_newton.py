@@ -1,0 +1,116 @@
+"""Globalised Newton's method on the KKT system `R(w) = 0` (Newton / Levenberg–Marquardt hybrid).
+
+Each step first tries the Newton step `d = −K⁻¹R` (with a regularisation μ = 1e-14 relative to
+the largest entry of K, enough to factorise an exactly singular K).  It is taken when it
+decreases the merit `φ = ½|R|²` by Armijo's factor; near a solution this is always the case,
+so convergence is quadratic, and a quadratic program is solved in one step.
+
+Otherwise the step is a Levenberg–Marquardt step `d = −(KᵀK + ν I)⁻¹ KᵀR`, a descent direction
+of `φ` for every ν > 0, with `ν = θ|R|` and θ adapted like a trust region radius by the ratio
+of actual to predicted decrease of `φ` (Fan–Yuan).  LM steps are well defined when K is
+singular (continuous symmetries, where the solutions form a manifold), and converge there too.
+
+The merit is the size of the residual, not the energy, so saddle points (Euler's figure-eight
+elastica) are found as readily as minima.  A minimisation problem started very far away is
+better served by `warm_start="lbfgs"`.  The loop is one `lax.while_loop`.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from ._kkt import KKT, scaled_residual
+
+CONVERGED, MAX_STEPS, STALLED, NONFINITE, RUNNING = 0, 1, 2, 3, -1
+STATUS_TEXT = {
+    CONVERGED: "converged",
+    MAX_STEPS: "reached max_steps",
+    STALLED: "stalled: no step decreases the residual, even a strongly damped one",
+    NONFINITE: "the energy or its derivatives became non-finite",
+}
+
+ARMIJO = 1e-4
+NEWTON_MU = 1e-14
+THETA_START, THETA_MIN, THETA_MAX = 1e-3, 1e-10, 1e12
+
+
+class NewtonState(NamedTuple):
+    w: jax.Array
+    R: jax.Array
+    residual: jax.Array
+    theta: jax.Array
+    step: jax.Array
+    history: jax.Array
+    status: jax.Array
+
+
+def _merit(R):
+    return 0.5 * jnp.dot(R, R)
+
+
+def _newton_trial(kkt: KKT, algebra, arrays, w, R):
+    d = algebra.solve(kkt, arrays, w, NEWTON_MU, -R)
+    R_new = kkt.residual(w + d)
+    ok = jnp.all(jnp.isfinite(d)) & jnp.isfinite(_merit(R_new)) & (_merit(R_new) <= (1 - 2 * ARMIJO) * _merit(R))
+    return d, R_new, ok
+
+
+def _lm_trial(kkt: KKT, algebra, arrays, w, R, theta):
+    """One Levenberg–Marquardt trial; returns the step, new residual, acceptance and new θ."""
+    nu = theta * jnp.linalg.norm(R)
+    d = algebra.lm_solve(kkt, arrays, w, nu, R)
+    R_new = kkt.residual(w + d)
+    predicted = _merit(R) - _merit(R + kkt.kkt_matvec(w, d))
+    actual = _merit(R) - _merit(R_new)
+    rho = jnp.where(predicted > 0, actual / predicted, -1.0)
+    rho = jnp.where(jnp.isfinite(rho) & jnp.all(jnp.isfinite(d)), rho, -1.0)
+    theta = jnp.where(rho < 0.25, 4.0 * theta, jnp.where(rho > 0.75, jnp.maximum(theta / 4, THETA_MIN), theta))
+    return d, R_new, rho > ARMIJO, theta
+
+
+def newton(kkt: KKT, algebra, arrays, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
+    n = kkt.spec.n
+    R0 = kkt.residual(w0)
+    res0 = scaled_residual(R0, weights, n)
+    history = jnp.full((max_steps + 1,), jnp.nan).at[0].set(res0)
+    go_on = RUNNING if max_steps > 0 else MAX_STEPS
+    finite = jnp.isfinite(res0) & jnp.isfinite(kkt.energy(kkt.split(w0)[0]))
+    status0 = jnp.where(finite, jnp.where(res0 <= tol, CONVERGED, go_on), NONFINITE)
+    state = NewtonState(w0, R0, res0, jnp.asarray(THETA_START), jnp.asarray(0), history, status0)
+
+    def cond(s: NewtonState):
+        return s.status == RUNNING
+
+    def body(s: NewtonState) -> NewtonState:
+        d, R_new, ok = _newton_trial(kkt, algebra, arrays, s.w, s.R)
+        theta = jnp.where(ok, jnp.maximum(s.theta / 4, THETA_MIN), s.theta)
+
+        # "if not ok: LM trial", written as a loop that runs 0 or 1 times rather than lax.cond:
+        # under vmap a cond with a batched predicate batches all its operands, incl. the
+        # sparse index arrays, which KLU cannot take batched; a while_loop keeps them unbatched.
+        def lm_cond(carry):
+            return ~carry[4]
+
+        def lm_body(carry):
+            return _lm_trial(kkt, algebra, arrays, s.w, s.R, carry[3]) + (jnp.asarray(True),)
+
+        d, R_new, ok, theta, _ = jax.lax.while_loop(lm_cond, lm_body, (d, R_new, ok, theta, ok))
+        w = jnp.where(ok, s.w + d, s.w)
+        R = jnp.where(ok, R_new, s.R)
+        residual = scaled_residual(R, weights, n)
+        step = s.step + 1
+        status = jnp.where(
+            residual <= tol,
+            CONVERGED,
+            jnp.where(
+                ~jnp.isfinite(residual),
+                NONFINITE,
+                jnp.where(theta >= THETA_MAX, STALLED, jnp.where(step >= max_steps, MAX_STEPS, RUNNING)),
+            ),
+        )
+        return NewtonState(w, R, residual, theta, step, s.history.at[step].set(residual), status)
+
+    return jax.lax.while_loop(cond, body, state)

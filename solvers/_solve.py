@@ -1,0 +1,184 @@
+"""`solve`: critical points of a constrained energy, their multipliers, and their derivatives."""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ddgjax._checks import is_concrete
+from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError
+from ddgjax.problem import Problem, validate_multipliers
+
+from ._first_order import augmented_lagrangian
+from ._implicit import implicit_solution
+from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
+from ._linear import DenseAlgebra, SparseAlgebra
+from ._newton import CONVERGED, NONFINITE, STATUS_TEXT, newton
+from ._sparse import cached_pattern
+
+METHODS = ("auto", "dense", "sparse", "lbfgs")
+DENSE_LIMIT = 1500  # n + m above which "auto" prefers the sparse path (when declared local)
+FIRST_ORDER_OUTER = 50
+
+
+class Solution(NamedTuple):
+    """The result of `solve`.
+
+    - `x`: the critical point, a pytree like `x0` (fixed entries bit-for-bit from `x0`).
+    - `multipliers`: 1-D, ordered like the constraint vector; `∇E(x) = Jg(x)ᵀ multipliers`.
+    - `energy`: `E(x)`.
+    - `residual`: max-norm of the (scaled) KKT residual at `x`.
+    - `steps`: Newton steps taken (outer augmented-Lagrangian steps for `method="lbfgs"`).
+    - `converged`: `residual <= tol`.
+    - `history`: residual after each step (`history[0]` at the start of Newton).
+    - `status`: 0 converged, 1 max_steps reached, 2 stalled, 3 non-finite.
+    """
+
+    x: object
+    multipliers: jax.Array
+    energy: jax.Array
+    residual: jax.Array
+    steps: jax.Array
+    converged: jax.Array
+    history: jax.Array
+    status: jax.Array
+
+
+def _choose_algebra(problem: Problem, spec: Spec, method: str):
+    if method == "sparse" and not spec.is_local:
+        raise InvalidInputError(
+            "method='sparse' needs an energy declared with dg.local_sum (and constraints with "
+            "dg.local_map / dg.local_sum / dg.concat) over a single array of unknowns"
+        )
+    sparse = method == "sparse" or (method == "auto" and spec.is_local and spec.n + spec.m > DENSE_LIMIT)
+    if sparse:
+        return SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
+    return DenseAlgebra()
+
+
+@partial(jax.jit, static_argnames=("spec", "algebra", "tol", "max_steps", "first_order", "newton_phase"))
+def _solve_jit(spec, algebra, arrays, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
+    z0_, params_ = jax.lax.stop_gradient((z0, params))
+    kkt = KKT(spec, z0_, params_)
+    u0 = z0_[spec.layout.free]
+    if lam0 is None:
+        # least-squares multipliers argmin |∇E − Jᵀλ|: the KKT system with ∇²L replaced by I
+        grad_e = jax.grad(kkt.energy)(u0)
+        w_probe = jnp.concatenate([u0, jnp.zeros((spec.m,), u0.dtype)])
+        rhs = jnp.concatenate([grad_e, jnp.zeros((spec.m,), u0.dtype)])
+        lam0 = -algebra.solve(kkt, arrays, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
+        lam0 = jnp.where(jnp.isfinite(lam0), lam0, 0.0)
+    w = jnp.concatenate([u0, lam0])
+    fo_steps = jnp.asarray(0)
+    if first_order:
+        w, fo_steps, _ = augmented_lagrangian(kkt, w, weights, tol=tol, outer_steps=first_order)
+    if newton_phase:
+        state = newton(kkt, algebra, arrays, w, weights, tol=tol, max_steps=max_steps)
+        w, residual, steps, history, status = state.w, state.residual, state.step, state.history, state.status
+    else:
+        residual = scaled_residual(kkt.residual(w), weights, spec.n)
+        steps, history = fo_steps, jnp.full((max_steps + 1,), jnp.nan).at[0].set(residual)
+        finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
+        status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
+
+    w = implicit_solution(spec, algebra, arrays, w, z0, params)
+    kkt_diff = KKT(spec, z0, params)
+    u, lam = kkt_diff.split(w)
+    x = kkt_diff.x(u)
+    energy = kkt_diff.energy(u)
+    return Solution(x, lam, energy, residual, steps, residual <= tol, history, status)
+
+
+def solve(
+    problem: Problem,
+    *,
+    tol: float = 1e-10,
+    max_steps: int = 100,
+    method: str = "auto",
+    throw: bool = True,
+    multipliers0=None,
+    warm_start: str | None = None,
+) -> Solution:
+    """Find a critical point of `problem.energy` on `problem.constraints == 0`.
+
+    Newton's method on the KKT system `∇E − Jᵀλ = 0, g = 0` over the free unknowns and the
+    multipliers, second derivatives by autodiff, globalised by a backtracking line search on
+    `½|R|²` and regularised so that singular KKT matrices (continuous symmetries, redundant
+    constraints) do not stop it.  Converges to saddle points as well as minima.
+
+    **Arguments:**
+    - `tol`: stop when the scaled max-norm KKT residual is `<= tol` (see `Problem.residual_scale`).
+    - `max_steps`: Newton steps (outer augmented-Lagrangian steps for `method="lbfgs"`).
+    - `method`: `"dense"` (LU, n ≲ 2,000), `"sparse"` (KLU on the KKT matrix assembled from a
+      locality declaration, `dg.local_sum`), `"lbfgs"` (augmented Lagrangian with jaxopt
+      L-BFGS inner solves: minimisation only, first-order), or `"auto"` (sparse when declared
+      local and larger than 1,500 unknowns + constraints, else dense).
+    - `throw`: raise `ConvergenceError` when not converged (only outside `jit`/`vmap`; inside
+      them check `Solution.converged`).
+    - `multipliers0`: starting multipliers (default: least squares `argmin |∇E − Jᵀλ|` at x0).
+    - `warm_start="lbfgs"`: run up to 50 augmented-Lagrangian L-BFGS steps before Newton, for
+      minimisation problems started far away.
+
+    **Returns:** a `Solution`. `jax.grad`/`jax.jacobian` of functions of `.x`, `.multipliers`,
+    `.energy` with respect to `problem.params` (and `x0`'s fixed entries) are exact (implicit
+    function theorem), and `jax.vmap` over `params` works.
+
+    **Raises:** `ConvergenceError` (with `.residual`, `.steps`, `.solution`), `NonFiniteError`
+    when the energy or residual is NaN at `x0`, `InvalidInputError` for unknown options.
+    """
+    if method not in METHODS:
+        raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
+    if warm_start not in (None, "lbfgs"):
+        raise InvalidInputError(f"warm_start must be None or 'lbfgs', got {warm_start!r}")
+    if not (tol > 0):
+        raise InvalidInputError(f"tol must be positive, got {tol}")
+    if int(max_steps) < 0:
+        raise InvalidInputError(f"max_steps must be >= 0, got {max_steps}")
+    validate_multipliers(problem, multipliers0)
+    spec = spec_of(problem)
+    if spec.n == 0:
+        raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
+    algebra = _choose_algebra(problem, spec, "dense" if method == "lbfgs" else method)
+    z0 = spec.layout.ravel(problem.x0)
+    lam0 = None if multipliers0 is None else jnp.asarray(multipliers0, dtype=z0.dtype)
+    first_order = FIRST_ORDER_OUTER if warm_start == "lbfgs" else (int(max_steps) if method == "lbfgs" else 0)
+    try:
+        sol = _solve_jit(
+            spec, algebra, algebra.arrays(), z0, problem.params, lam0, residual_weights(problem, spec),
+            tol=float(tol), max_steps=int(max_steps), first_order=first_order, newton_phase=method != "lbfgs",
+        )
+    except jax.errors.JaxRuntimeError as err:  # KLU reports an exactly singular matrix this way
+        raise ConvergenceError(
+            f"{_label(problem)}the sparse linear solve failed ({err}); try method='dense' to diagnose",
+            residual=float("nan"), steps=0,
+        ) from None
+    if not is_concrete(sol):
+        return sol
+    return _finish(problem, sol, throw, tol)
+
+
+def _label(problem: Problem) -> str:
+    return f"{problem.name}: " if problem.name else ""
+
+
+def _finish(problem: Problem, sol: Solution, throw: bool, tol: float) -> Solution:
+    steps = int(sol.steps)
+    sol = sol._replace(history=sol.history[: steps + 1])
+    status = int(sol.status)
+    if status == NONFINITE and steps == 0:
+        raise NonFiniteError(
+            f"{_label(problem)}the energy or the KKT residual is not finite at x0 (residual "
+            f"{float(sol.residual)}): check the energy's domain at the starting point"
+        )
+    if throw and not bool(sol.converged):
+        raise ConvergenceError(
+            f"{_label(problem)}solve did not converge: {STATUS_TEXT.get(status, status)} after {steps} "
+            f"steps with KKT residual {float(sol.residual):.3e} > tol {tol:.1e}. Try a better x0, "
+            "warm_start='lbfgs' (for minimisation), a larger max_steps, or a looser tol.",
+            residual=float(sol.residual), steps=steps, solution=sol,
+        )
+    return sol

@@ -1,0 +1,188 @@
+"""Sparse KKT matrices from declared locality (finite-element style assembly).
+
+For `E = Σ_k e(x[stencil_k])` the Hessian is `Σ_k P_kᵀ ∇²e P_k`: each cell adds a dense
+(s·d)×(s·d) block at the rows and columns of the entries it reads.  The same holds for
+`−λ·g` and, row by row, for the constraint Jacobian.  The pattern (which raw block entry goes
+to which coalesced matrix entry) is computed once with NumPy from the stencils and the fixed
+mask, and cached on the energy declaration; every Newton step then evaluates the blocks with
+`vmap`ed `jax.hessian` / `jax.jacfwd` and sums duplicates with one `segment_sum`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ddgjax.errors import InvalidInputError
+from ddgjax.locality import Local, Term
+
+from ._kkt import KKT, Spec
+
+
+@dataclass(frozen=True, eq=False)
+class TermPattern:
+    term: Term
+    columns: np.ndarray  # (K, s·d) flat indices of the entries the cell reads
+    rows: np.ndarray | None  # (K, c) constraint rows the cell writes (constraints only)
+
+
+@dataclass(frozen=True, eq=False)
+class SparsePattern:
+    n: int
+    m: int
+    energy_terms: tuple[TermPattern, ...]
+    constraint_terms: tuple[TermPattern, ...]
+    rows: np.ndarray  # (nnz,) int32, coalesced COO rows of the KKT matrix
+    cols: np.ndarray  # (nnz,) int32
+    source: np.ndarray  # (n_raw,) int32: index into the raw block values
+    target: np.ndarray  # (n_raw + n + m,) int32: coalesced entry of each raw value and diagonal
+
+    @property
+    def nnz(self) -> int:
+        return int(self.rows.size)
+
+    def augmented(self) -> tuple[np.ndarray, np.ndarray]:
+        """COO indices of the Levenberg–Marquardt matrix `[[I, K], [Kᵀ, −νI]]` (values: 1, K, K, −ν)."""
+        size = self.n + self.m
+        diag = np.arange(size)
+        rows = np.concatenate([diag, self.rows, size + self.cols, size + diag])
+        cols = np.concatenate([diag, size + self.cols, self.rows, size + diag])
+        return rows.astype(np.int32), cols.astype(np.int32)
+
+    def arrays(self) -> dict:
+        """The index arrays as jax arrays (made once, then reused)."""
+        if "_arrays" not in self.__dict__:
+            arrays = {k: jnp.asarray(getattr(self, k)) for k in ("rows", "cols", "source", "target")}
+            arrays["aug_rows"], arrays["aug_cols"] = (jnp.asarray(a) for a in self.augmented())
+            self.__dict__["_arrays"] = arrays
+        return self.__dict__["_arrays"]
+
+
+def _columns(term: Term, width: int, n_rows: int) -> np.ndarray:
+    if term.stencil.size and term.stencil.max() >= n_rows:
+        k = int(np.argwhere(term.stencil >= n_rows)[0][0])
+        raise InvalidInputError(
+            f"stencil row {k} reads row {int(term.stencil[k].max())} of x, which has only {n_rows} rows"
+        )
+    return (term.stencil[:, :, None] * width + np.arange(width)).reshape(len(term.stencil), -1)
+
+
+def _output_size(term: Term, x0, params) -> int:
+    local = jax.ShapeDtypeStruct((term.stencil.shape[1],) + x0.shape[1:], x0.dtype)
+    data = jax.tree_util.tree_map(lambda a: jax.ShapeDtypeStruct(a.shape[1:], a.dtype), term.data)
+    out = jax.eval_shape(lambda xl, dk: term.cell(xl, dk, params), local, data)
+    return int(np.prod(out.shape, dtype=int))
+
+
+def _constraint_rows(constraints: Local, x0, params):
+    """Per term, the (K, c) array of constraint-vector rows it writes."""
+    out, offset = [], 0
+    for group in constraints.groups:
+        sizes = []
+        for term in group:
+            c = _output_size(term, x0, params)
+            K = len(term.stencil)
+            if term.reduce == "sum":
+                rows = np.broadcast_to(offset + np.arange(c), (K, c))
+                sizes.append(c)
+            else:
+                rows = offset + np.arange(K * c).reshape(K, c)
+                sizes.append(K * c)
+            out.append((term, rows))
+        offset += sizes[0]
+    return out
+
+
+def build_pattern(spec: Spec, x0, params) -> SparsePattern:
+    """Static sparsity of the KKT matrix of a local problem (see module docstring)."""
+    shape = spec.layout.shapes[0]
+    width = shape[1] if len(shape) == 2 else 1
+    n_rows = shape[0]
+    n, m = spec.n, spec.m
+    free_of = np.full(spec.layout.n_total, -1, dtype=np.int64)
+    free_of[spec.layout.free] = np.arange(n)
+
+    energy_terms = tuple(TermPattern(t, _columns(t, width, n_rows), None) for t in spec.energy.groups[0])
+    cons = [] if spec.constraints is None else _constraint_rows(spec.constraints, x0, params)
+    constraint_terms = tuple(TermPattern(t, _columns(t, width, n_rows), rows) for t, rows in cons)
+
+    r_list, c_list, src_list, offset = [], [], [], 0
+    for tp in energy_terms + constraint_terms:  # Hessian blocks
+        K, sd = tp.columns.shape
+        rr = np.repeat(tp.columns, sd, axis=1).ravel()
+        cc = np.tile(tp.columns, (1, sd)).ravel()
+        fr, fc = free_of[rr], free_of[cc]
+        keep = (fr >= 0) & (fc >= 0)
+        r_list.append(fr[keep]); c_list.append(fc[keep])
+        src_list.append(offset + np.flatnonzero(keep))
+        offset += K * sd * sd
+    for tp in constraint_terms:  # Jacobian blocks, stored once, used for -J and -Jᵀ
+        K, sd = tp.columns.shape
+        c = tp.rows.shape[1]
+        rr = np.repeat(tp.rows, sd, axis=1).reshape(K, c, sd)
+        cc = np.broadcast_to(tp.columns[:, None, :], (K, c, sd))
+        fc = free_of[cc.ravel()]
+        keep = fc >= 0
+        src = offset + np.flatnonzero(keep)
+        r_list += [n + rr.ravel()[keep], fc[keep]]
+        c_list += [fc[keep], n + rr.ravel()[keep]]
+        src_list += [src, src]
+        offset += K * c * sd
+    diag = np.arange(n + m)
+    rows = np.concatenate(r_list + [diag])
+    cols = np.concatenate(c_list + [diag])
+    keys, target = np.unique(rows * (n + m) + cols, return_inverse=True)
+    return SparsePattern(
+        n=n,
+        m=m,
+        energy_terms=energy_terms,
+        constraint_terms=constraint_terms,
+        rows=(keys // (n + m)).astype(np.int32),
+        cols=(keys % (n + m)).astype(np.int32),
+        source=np.concatenate(src_list).astype(np.int32),
+        target=target.astype(np.int32),
+    )
+
+
+def cached_pattern(spec: Spec, x0, params) -> SparsePattern:
+    """`build_pattern`, memoised on the energy declaration (no module-level cache)."""
+    store = spec.energy.__dict__.setdefault("_patterns", {})
+    key = (spec.key(),)
+    if key not in store:
+        store.clear()  # keep one pattern per declaration: they can be large
+        store[key] = build_pattern(spec, x0, params)
+    return store[key]
+
+
+def _cell_hessians(term: Term, x, params, weights=None):
+    def cell_value(xl, dk, wk):
+        val = jnp.ravel(term.cell(xl, dk, params))
+        return val[0] if wk is None else -jnp.dot(wk, val)
+
+    local = x[term.stencil]
+    H = jax.vmap(jax.hessian(cell_value), in_axes=(0, 0, 0))(local, term.data, weights)
+    return H.reshape(-1)
+
+
+def _cell_jacobians(term: Term, x, params):
+    local = x[term.stencil]
+    J = jax.vmap(jax.jacfwd(lambda xl, dk: jnp.ravel(term.cell(xl, dk, params))))(local, term.data)
+    return J.reshape(-1)
+
+
+def cell_blocks(pattern: SparsePattern, kkt: KKT, w, identity_hessian: bool):
+    """Raw values `(hessian blocks, jacobian blocks)` in the order `build_pattern` expects."""
+    u, lam = kkt.split(w)
+    x = kkt.x(u)
+    if identity_hessian:
+        size = sum(tp.columns.shape[0] * tp.columns.shape[1] ** 2 for tp in pattern.energy_terms + pattern.constraint_terms)
+        hess = jnp.zeros((size,), dtype=w.dtype)
+    else:
+        pieces = [_cell_hessians(tp.term, x, kkt.params) for tp in pattern.energy_terms]
+        pieces += [_cell_hessians(tp.term, x, kkt.params, lam[tp.rows]) for tp in pattern.constraint_terms]
+        hess = jnp.concatenate(pieces)
+    jac = [_cell_jacobians(tp.term, x, kkt.params) for tp in pattern.constraint_terms]
+    return hess, (jnp.concatenate(jac) if jac else jnp.zeros((0,), dtype=w.dtype))

@@ -1,0 +1,203 @@
+"""Acceptance tests of `solvers.solve` (issue: foundation).
+
+Each test asserts a number the mathematics fixes: a KKT residual, an eigenvalue, a closed-form
+multiplier, bit-for-bit fixed entries.
+"""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import ddgjax as dg
+from solvers import solve
+
+from problems import random_symmetric, rayleigh, unit_chain
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_rayleigh_quotient_multiplier_is_eigenvalue(seed):
+    """∇(xᵀAx) = λ∇(|x|²) ⇔ Ax = λx: the multiplier is an eigenvalue, x its eigenvector."""
+    n = 50
+    A = random_symmetric(n, seed)
+    x0 = np.random.default_rng(100 + seed).normal(size=n)
+    sol = solve(rayleigh(A, x0))
+    assert sol.converged and float(sol.residual) <= 1e-10
+    lam = float(sol.multipliers[0])
+    eigenvalues = np.linalg.eigh(A)[0]
+    assert np.min(np.abs(eigenvalues - lam)) <= 1e-10
+    x = np.asarray(sol.x)
+    assert np.linalg.norm(A @ x - lam * x, np.inf) <= 1e-10
+    assert abs(x @ x - 1) <= 1e-10  # the constraint part of the KKT residual
+
+
+def test_equality_constrained_qp_one_newton_step():
+    """E = ½xᵀQx + cᵀx, Bx = b: one Newton step; λ from the KKT system in closed form."""
+    rng = np.random.default_rng(7)
+    n, m = 12, 4
+    M = rng.normal(size=(n, n))
+    Q, c = M @ M.T + n * np.eye(n), rng.normal(size=n)
+    B, b = rng.normal(size=(m, n)), rng.normal(size=m)
+    problem = dg.Problem(
+        lambda x, _: 0.5 * x @ Q @ x + c @ x, np.zeros(n), constraints=lambda x, _: B @ x - b
+    )
+    sol = solve(problem)
+    # ∇E − Bᵀλ = 0, Bx = b  ⇔  [[Q, −Bᵀ], [B, 0]] (x, λ) = (−c, b)
+    K = np.block([[Q, -B.T], [B, np.zeros((m, m))]])
+    closed = np.linalg.solve(K, np.concatenate([-c, b]))
+    assert int(sol.steps) == 1
+    assert np.max(np.abs(np.asarray(sol.x) - closed[:n])) <= 1e-10
+    assert np.max(np.abs(np.asarray(sol.multipliers) - closed[n:])) <= 1e-10
+
+
+def test_fixed_entries_bit_for_bit():
+    problem = unit_chain(12, local=False)
+    x0 = np.asarray(problem.x0)
+    sol = solve(problem)
+    assert sol.converged
+    fixed = np.asarray(problem.fixed)
+    x = np.asarray(sol.x)
+    assert np.array_equal(x[fixed].view(np.int64), x0[fixed].view(np.int64))
+    assert np.max(np.abs(x[~fixed] - x0[~fixed])) > 1e-3  # the free entries did move
+
+
+def test_fixed_entries_in_a_pytree():
+    """`fixed` follows the pytree of x0; unconstrained quadratic with a pinned leaf entry."""
+    x0 = {"a": np.array([1.0, 2.0, 3.0]), "b": np.array(5.0)}
+    fixed = {"a": np.array([False, True, False]), "b": np.array(False)}
+
+    def energy(x, _):
+        return jnp.sum((x["a"] - 7.0) ** 2) + (x["b"] + x["a"][1]) ** 2
+
+    sol = solve(dg.Problem(energy, x0, fixed=fixed))
+    assert float(sol.x["a"][1]) == 2.0
+    np.testing.assert_allclose(np.asarray(sol.x["a"])[[0, 2]], 7.0, atol=1e-12)
+    np.testing.assert_allclose(float(sol.x["b"]), -2.0, atol=1e-12)
+
+
+def _thomson(n, seed):
+    def coulomb(X, _):
+        i, j = np.triu_indices(len(X), 1)
+        return jnp.sum(1.0 / jnp.linalg.norm(X[i] - X[j], axis=1))
+
+    X0 = np.random.default_rng(seed).normal(size=(n, 3))
+    return dg.Problem(coulomb, X0, constraints=lambda X, _: jnp.sum(X**2, axis=1) - 1.0)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_continuous_symmetry_singular_kkt_converges(seed):
+    """Charges on a sphere: E is SO(3)-invariant, so K has a 3-dimensional kernel at x*."""
+    problem = _thomson(7, seed)
+    sol = solve(problem)
+    assert float(sol.residual) <= 1e-10
+    # the KKT matrix at the answer really is singular: three (near-)zero singular values
+    w = jnp.concatenate([jnp.ravel(sol.x), sol.multipliers])
+    n = 21
+
+    def lagrangian(w):
+        X = w[:n].reshape(7, 3)
+        return problem.energy(X, None) - w[n:] @ problem.constraints(X, None)
+
+    s = np.linalg.svd(np.asarray(jax.hessian(lagrangian)(w)), compute_uv=False)
+    assert np.sum(s <= 1e-8 * s[0]) >= 3
+
+
+def test_rotation_invariant_chain_converges():
+    """A closed chain of unit vectors with E = Σ (<X_k, X_{k+1}> − ½)²: SO(3)-invariant."""
+    n = 9
+
+    def energy(X, _):
+        return jnp.sum((jnp.sum(X * jnp.roll(X, -1, axis=0), axis=1) - 0.5) ** 2)
+
+    X0 = np.random.default_rng(3).normal(size=(n, 3))
+    problem = dg.Problem(energy, X0, constraints=lambda X, _: jnp.sum(X**2, axis=1) - 1.0)
+    sol = solve(problem)
+    assert float(sol.residual) <= 1e-10
+
+
+def test_history_records_quadratic_convergence():
+    """Newton near the answer: each residual is at most C·(previous)² for the last steps."""
+    A = random_symmetric(20, 5)
+    sol = solve(rayleigh(A, np.linalg.eigh(A)[1][:, 3] + 0.05))
+    h = np.asarray(sol.history)
+    assert len(h) == int(sol.steps) + 1 and h[-1] <= 1e-10
+    assert h[-1] <= 10 * h[-2] ** 2 * max(1.0, 1 / h[-3])
+
+
+def test_euler_lagrange_vanishes_at_solution_and_on_fixed_entries():
+    problem = unit_chain(10, local=False, chord=(8.0, 4.2, 0.3))
+    sol = solve(problem)
+    el = dg.euler_lagrange(problem)(sol.x, sol.multipliers)
+    assert float(jnp.max(jnp.abs(el))) <= 1e-10
+    el0 = np.asarray(dg.euler_lagrange(problem)(problem.x0, sol.multipliers))
+    assert np.all(el0[np.asarray(problem.fixed)] == 0.0) and np.max(np.abs(el0)) > 1e-3
+
+
+def test_sparse_and_dense_paths_agree():
+    """The KLU path on the assembled KKT matrix gives the dense path's answer."""
+    dense = solve(unit_chain(40, chord=(32.0, 17.0, 0.5), local=False), method="dense")
+    sparse = solve(unit_chain(40, chord=(32.0, 17.0, 0.5)), method="sparse")
+    local_dense = solve(unit_chain(40, chord=(32.0, 17.0, 0.5)), method="dense")
+    assert float(sparse.residual) <= 1e-10 and float(dense.residual) <= 1e-10
+    assert float(jnp.max(jnp.abs(sparse.x - dense.x))) <= 1e-10
+    assert float(jnp.max(jnp.abs(sparse.multipliers - dense.multipliers))) <= 1e-10
+    assert float(jnp.max(jnp.abs(local_dense.x - dense.x))) <= 1e-10
+
+
+def test_sparse_kkt_matrix_equals_dense_hessian():
+    """Assembled cell blocks (incl. −λ·∇²g and ±J) equal jax.hessian of the Lagrangian."""
+    from solvers._kkt import KKT, spec_of
+    from solvers._sparse import build_pattern, cell_blocks
+
+    problem = unit_chain(8, chord=(6.5, 3.5, 0.2))
+    spec = spec_of(problem)
+    pattern = build_pattern(spec, problem.x0, problem.params)
+    z0 = spec.layout.ravel(problem.x0)
+    kkt = KKT(spec, z0, problem.params)
+    rng = np.random.default_rng(0)
+    w = jnp.asarray(rng.normal(size=spec.n + spec.m))
+    hess, jac = jax.jit(lambda w: cell_blocks(pattern, kkt, w, False))(w)
+    raw = jnp.concatenate([hess, -jac])
+    values = jnp.concatenate([raw[pattern.source], jnp.zeros(spec.n + spec.m)])
+    coo = np.asarray(jax.ops.segment_sum(values, pattern.target, num_segments=pattern.nnz))
+    K = np.zeros((spec.n + spec.m,) * 2)
+    K[pattern.rows, pattern.cols] = coo
+    dense = np.asarray(jax.jit(jax.hessian(kkt.lagrangian))(w))
+    assert np.max(np.abs(K - dense)) <= 1e-12
+
+
+def test_auto_uses_sparse_path_for_large_local_problems():
+    from solvers._linear import SparseAlgebra
+    from solvers._solve import _choose_algebra
+    from solvers._kkt import spec_of
+
+    problem = unit_chain(600, noise=0.5 / 600)
+    assert isinstance(_choose_algebra(problem, spec_of(problem), "auto"), SparseAlgebra)
+    sol = solve(problem)
+    assert float(sol.residual) <= 1e-10
+
+
+def test_lbfgs_method_solves_minimisation_alone():
+    from problems import nearest_point_on_sphere
+
+    c = np.array([1.0, 2.0, -0.5])
+    sol = solve(nearest_point_on_sphere(c, 1.5), method="lbfgs", tol=1e-9)
+    assert float(sol.residual) <= 1e-9
+    np.testing.assert_allclose(np.asarray(sol.x), 1.5 * c / np.linalg.norm(c), atol=1e-9)
+    np.testing.assert_allclose(float(sol.multipliers[0]), 1 - np.linalg.norm(c) / 1.5, atol=1e-9)
+
+
+def test_warm_start_reaches_minimum_from_far_away():
+    """Six charges: L-BFGS phase then Newton; the minimum is the octahedron, E = 3/2 + 12/√2."""
+    sol = solve(_thomson(6, 11), warm_start="lbfgs")
+    assert float(sol.residual) <= 1e-10
+    assert abs(float(sol.energy) - (1.5 + 12 / np.sqrt(2))) <= 1e-9
+
+
+def test_residual_scale_is_applied():
+    """`residual_scale` multiplies the stationarity and constraint parts of the residual."""
+    A = random_symmetric(10, 2)
+    x0 = np.random.default_rng(0).normal(size=10)
+    plain = solve(rayleigh(A, x0), max_steps=2, throw=False)
+    scaled = solve(rayleigh(A, x0, residual_scale=(1e-3, 1e-3)), max_steps=2, throw=False)
+    np.testing.assert_allclose(float(scaled.residual), 1e-3 * float(plain.residual), rtol=1e-12)
