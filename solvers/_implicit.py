@@ -19,26 +19,26 @@ ADJOINT_MU = 1e-13  # relative regularisation of the adjoint solve (singular K u
 
 
 @partial(jax.custom_vjp, nondiff_argnums=(0, 1))
-def implicit_solution(spec, algebra, arrays, w_star, z0, params):
+def implicit_solution(spec, algebra, w_star, z0, params):
     """Identity on `w_star`; its derivative is that of the KKT point as a function of (z0, params)."""
     return w_star
 
 
-def _fwd(spec, algebra, arrays, w_star, z0, params):
-    return w_star, (arrays, w_star, z0, params)
+def _fwd(spec, algebra, w_star, z0, params):
+    return w_star, (w_star, z0, params)
 
 
 def _bwd(spec, algebra, residuals, w_bar):
-    arrays, w_star, z0, params = residuals
+    w_star, z0, params = residuals
     kkt = KKT(spec, z0, params)
-    v = algebra.solve(kkt, arrays, w_star, ADJOINT_MU, w_bar)
+    v = algebra.solve(kkt, w_star, ADJOINT_MU, w_bar)
 
     def R_of(z0_, params_):
         return KKT(spec, z0_, params_).residual(w_star)
 
     _, vjp = jax.vjp(R_of, z0, params)
     z0_bar, params_bar = vjp(-v)
-    return None, jnp.zeros_like(w_star), z0_bar, params_bar
+    return jnp.zeros_like(w_star), z0_bar, params_bar
 
 
 implicit_solution.defvjp(_fwd, _bwd)

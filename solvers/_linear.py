@@ -5,17 +5,20 @@ singular (a continuous symmetry of the energy, redundant constraints); with μ p
 the residual it leaves Newton's quadratic convergence intact.  `μ` is given relative to the
 largest entry of `K`, so that it means the same whatever the scaling of the energy.
 
-Two interchangeable back ends with one method, `solve(kkt, arrays, w, mu_rel, b, identity_hessian)`
-(`arrays`: the back end's index arrays, passed explicitly so that they are ordinary traced
-arguments of the jitted solver; `None` for the dense back end).  The back ends themselves are
-static and hashable:
+Two interchangeable back ends, static and hashable, with the methods
+- `factor(kkt, w, mu_rel, identity_hessian=False) -> fac`: build (and for the dense
+  back end, LU-factorise) `K(w) + μS`;
+- `apply(fac, b)`: solve with it (Newton's damping test reuses one factorisation);
+- `solve(...)`: both at once;
+- `lm_solve(kkt, w, nu, R)`: the Levenberg–Marquardt step `−(KᵀK + ν I)⁻¹ KᵀR`.
+The sparse back end's index arrays enter the compiled solver as constants (it is a static
+argument of `jit`): XLA's gathers and scatters with constant indices are ~10× faster than
+with traced ones.
 - `DenseAlgebra`: `K` by forward-over-reverse autodiff, LU through lineax.  For n ≲ 2,000.
 - `SparseAlgebra`: `K` assembled from the per-cell Hessian blocks of a problem declared with
   `dg.local_sum` / `dg.local_map`, factorised by KLU (klujax), inside `jit`, `vmap`-able.
-
-`lm_solve(kkt, arrays, w, nu, R)` returns the Levenberg–Marquardt step
-`d = −(KᵀK + ν I)⁻¹ KᵀR` (dense: normal equations; sparse: the augmented system
-`[[I, K], [Kᵀ, −ν I]] (s, d) = (−R, 0)`, which keeps K's sparsity).
+  Its LM step solves the augmented system `[[I, K], [Kᵀ, −ν I]] (s, d) = (−R, 0)`, which
+  keeps K's sparsity.
 
 `identity_hessian=True` replaces `∇²L` by the identity: the system then gives the least-squares
 multipliers `argmin_λ |∇E − Jᵀλ|` used to start Newton.
@@ -46,10 +49,7 @@ class DenseAlgebra:
     def __eq__(self, other):
         return isinstance(other, DenseAlgebra)
 
-    def arrays(self):
-        return None
-
-    def solve(self, kkt: KKT, arrays, w, mu_rel, b, identity_hessian=False):
+    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
         n, m = kkt.spec.n, kkt.spec.m
         if identity_hessian:
             u, _ = kkt.split(w)
@@ -59,16 +59,38 @@ class DenseAlgebra:
             K = jax.hessian(kkt.lagrangian)(w)
         scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
         K = K + jnp.diag(_regularisation(n, m, jnp.maximum(mu_rel * scale, MU_FLOOR)))
-        return _lu_solve(K, b)
+        return _LU.init(lx.MatrixLinearOperator(K), {})
 
-    def lm_solve(self, kkt: KKT, arrays, w, nu, R):
+    def apply(self, fac, b):
+        return _LU.compute(fac, b, {})[0]
+
+    def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
+        return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
+
+    def lm_solve(self, kkt: KKT, w, nu, R):
         K = jax.hessian(kkt.lagrangian)(w)
         normal = K.T @ K + nu * jnp.eye(K.shape[0])
-        return _lu_solve(normal, -K.T @ R)
+        return self.apply(_LU.init(lx.MatrixLinearOperator(normal), {}), -K.T @ R)
 
 
-def _lu_solve(A, b):
-    return lx.linear_solve(lx.MatrixLinearOperator(A), b, lx.LU(), throw=False).value
+_LU = lx.LU()
+
+
+def _klu_solve(rows, cols, values, b, symbolic):
+    """Solve with KLU, reusing a symbolic analysis, for COO indices already sorted by (row, col).
+
+    `klujax.solve_with_symbol` lexsorts the indices on every call; our patterns are sorted
+    when built (`np.unique`), so we bind its primitive directly: that sort cost ~30% of a
+    sparse Newton step at 10⁴ unknowns, and constant-folding it made compiles take ~30 s.
+    `tests/test_solve.py` checks this against `klujax.solve`.
+    """
+    import klujax
+
+    handle = jnp.asarray(symbolic.raw, dtype=jnp.uint64)
+    x = klujax.solve_with_symbol_f64.bind(
+        jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], b[None, :, None], handle
+    )
+    return x.reshape(b.shape)
 
 
 class SparseAlgebra:
@@ -83,33 +105,31 @@ class SparseAlgebra:
     def __eq__(self, other):
         return isinstance(other, SparseAlgebra) and other.pattern is self.pattern
 
-    def arrays(self):
-        return self.pattern.arrays()
-
-    def _values(self, kkt: KKT, arrays, w, mu_rel, identity_hessian):
+    def _values(self, kkt: KKT, w, mu_rel, identity_hessian):
         """Coalesced COO values of `K + μS` (K's Hessian block replaced by I if asked)."""
-        n, m = kkt.spec.n, kkt.spec.m
-        hess, jac = cell_blocks(self.pattern, kkt, w, identity_hessian)
+        n, m, p = kkt.spec.n, kkt.spec.m, self.pattern
+        hess, jac = cell_blocks(p, kkt, w, identity_hessian)
         raw = jnp.concatenate([hess, -jac])
         scale = jnp.maximum(jnp.max(jnp.abs(raw)) if raw.size else 1.0, 1.0)
         diag = _regularisation(n, m, mu_rel * scale)
         if identity_hessian:
             diag = diag.at[:n].add(1.0)
-        values = jnp.concatenate([raw[arrays["source"]], diag])
-        return jax.ops.segment_sum(values, arrays["target"], num_segments=self.pattern.nnz)
+        values = jnp.concatenate([raw[p.source], diag])
+        return jax.ops.segment_sum(values, p.target, num_segments=self.pattern.nnz)
 
-    def solve(self, kkt: KKT, arrays, w, mu_rel, b, identity_hessian=False):
-        import klujax
+    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
+        return self._values(kkt, w, jnp.maximum(mu_rel, MU_FLOOR), identity_hessian)
 
-        mu_rel = jnp.maximum(mu_rel, MU_FLOOR)
-        values = self._values(kkt, arrays, w, mu_rel, identity_hessian)
-        return klujax.solve(arrays["rows"], arrays["cols"], values, b)
+    def apply(self, fac, b):
+        return _klu_solve(self.pattern.rows, self.pattern.cols, fac, b, self.pattern.symbolic())
 
-    def lm_solve(self, kkt: KKT, arrays, w, nu, R):
-        import klujax
+    def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
+        return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
 
+    def lm_solve(self, kkt: KKT, w, nu, R):
         size = R.shape[0]
-        values = self._values(kkt, arrays, w, 0.0, False)
+        values = self._values(kkt, w, 0.0, False)
         aug = jnp.concatenate([jnp.ones((size,)), values, values, jnp.full((size,), -nu)])
         rhs = jnp.concatenate([-R, jnp.zeros_like(R)])
-        return klujax.solve(arrays["aug_rows"], arrays["aug_cols"], aug, rhs)[size:]
+        rows, cols, order = self.pattern.augmented()
+        return _klu_solve(rows, cols, aug[order], rhs, self.pattern.symbolic(augmented=True))[size:]

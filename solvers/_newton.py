@@ -1,11 +1,12 @@
 """Globalised Newton's method on the KKT system `R(w) = 0` (Newton / Levenberg–Marquardt hybrid).
 
-Each step first tries the Newton step `d = −K⁻¹R` (with a regularisation μ = 1e-14 relative to
-the largest entry of K, enough to factorise an exactly singular K).  It is taken when it
-decreases the merit `φ = ½|R|²` by Armijo's factor; near a solution this is always the case,
-so convergence is quadratic, and a quadratic program is solved in one step.
+Each step first tries the Newton step `Δ = −K⁻¹R` (with a regularisation μ = 1e-14 relative to
+the largest entry of K, enough to factorise an exactly singular K), damped `αΔ` with
+α = 1, ½, … until Deuflhard's natural monotonicity test holds (`_newton_trial`); near a
+solution the full step is taken, so convergence is quadratic, and a quadratic program takes
+one step.
 
-Otherwise the step is a Levenberg–Marquardt step `d = −(KᵀK + ν I)⁻¹ KᵀR`, a descent direction
+If even α = 2⁻¹⁰ fails, the step is a Levenberg–Marquardt step on the merit `φ = ½|R|²`, `d = −(KᵀK + ν I)⁻¹ KᵀR`, a descent direction
 of `φ` for every ν > 0, with `ν = θ|R|` and θ adapted like a trust region radius by the ratio
 of actual to predicted decrease of `φ` (Fan–Yuan).  LM steps are well defined when K is
 singular (continuous symmetries, where the solutions form a manifold), and converge there too.
@@ -34,6 +35,7 @@ STATUS_TEXT = {
 
 ARMIJO = 1e-4
 NEWTON_MU = 1e-14
+MIN_NEWTON_STEP = 2.0**-10
 THETA_START, THETA_MIN, THETA_MAX = 1e-3, 1e-10, 1e12
 
 
@@ -51,17 +53,43 @@ def _merit(R):
     return 0.5 * jnp.dot(R, R)
 
 
-def _newton_trial(kkt: KKT, algebra, arrays, w, R):
-    d = algebra.solve(kkt, arrays, w, NEWTON_MU, -R)
-    R_new = kkt.residual(w + d)
-    ok = jnp.all(jnp.isfinite(d)) & jnp.isfinite(_merit(R_new)) & (_merit(R_new) <= (1 - 2 * ARMIJO) * _merit(R))
-    return d, R_new, ok
+def _newton_trial(kkt: KKT, algebra, w, R):
+    """Damped Newton step with Deuflhard's affine-covariant monotonicity test.
+
+    With the Newton correction `Δ = −K(w)⁻¹R(w)` and, for a trial `w + αΔ`, the simplified
+    correction `Δ̄ = −K(w)⁻¹R(w + αΔ)` (same factorisation), the step is accepted when
+    `|Δ̄| ≤ (1 − α/4)|Δ|`, for the largest α in {1, ½, …, 2⁻¹⁰}.  Unlike a test on |R| this
+    does not depend on how the equations are scaled, so a start with a small residual but far
+    from the answer (a field acting on a long chain) still takes long steps.  Near a solution
+    `|Δ̄| = O(|Δ|²)` and α = 1: quadratic convergence.  Returns (α Δ, R(w + αΔ), accepted).
+    """
+    fac = algebra.factor(kkt, w, NEWTON_MU)
+    delta = algebra.apply(fac, -R)
+    size = jnp.linalg.norm(delta)
+
+    def trial(alpha):
+        R_new = kkt.residual(w + alpha * delta)
+        simplified = jnp.linalg.norm(algebra.apply(fac, -R_new))
+        ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & (simplified <= (1 - alpha / 4) * size)
+        return R_new, ok
+
+    def cond(carry):
+        alpha, _, ok = carry
+        return (~ok) & (alpha > MIN_NEWTON_STEP)
+
+    def body(carry):
+        alpha = 0.5 * carry[0]
+        return (alpha,) + trial(alpha)
+
+    one = jnp.asarray(1.0, w.dtype)
+    alpha, R_new, ok = jax.lax.while_loop(cond, body, (one,) + trial(one))
+    return alpha * delta, R_new, ok & jnp.isfinite(size)
 
 
-def _lm_trial(kkt: KKT, algebra, arrays, w, R, theta):
+def _lm_trial(kkt: KKT, algebra, w, R, theta):
     """One Levenberg–Marquardt trial; returns the step, new residual, acceptance and new θ."""
     nu = theta * jnp.linalg.norm(R)
-    d = algebra.lm_solve(kkt, arrays, w, nu, R)
+    d = algebra.lm_solve(kkt, w, nu, R)
     R_new = kkt.residual(w + d)
     predicted = _merit(R) - _merit(R + kkt.kkt_matvec(w, d))
     actual = _merit(R) - _merit(R_new)
@@ -71,7 +99,7 @@ def _lm_trial(kkt: KKT, algebra, arrays, w, R, theta):
     return d, R_new, rho > ARMIJO, theta
 
 
-def newton(kkt: KKT, algebra, arrays, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
+def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
     n = kkt.spec.n
     R0 = kkt.residual(w0)
     res0 = scaled_residual(R0, weights, n)
@@ -85,7 +113,7 @@ def newton(kkt: KKT, algebra, arrays, w0, weights, *, tol: float, max_steps: int
         return s.status == RUNNING
 
     def body(s: NewtonState) -> NewtonState:
-        d, R_new, ok = _newton_trial(kkt, algebra, arrays, s.w, s.R)
+        d, R_new, ok = _newton_trial(kkt, algebra, s.w, s.R)
         theta = jnp.where(ok, jnp.maximum(s.theta / 4, THETA_MIN), s.theta)
 
         # "if not ok: LM trial", written as a loop that runs 0 or 1 times rather than lax.cond:
@@ -95,7 +123,7 @@ def newton(kkt: KKT, algebra, arrays, w0, weights, *, tol: float, max_steps: int
             return ~carry[4]
 
         def lm_body(carry):
-            return _lm_trial(kkt, algebra, arrays, s.w, s.R, carry[3]) + (jnp.asarray(True),)
+            return _lm_trial(kkt, algebra, s.w, s.R, carry[3]) + (jnp.asarray(True),)
 
         d, R_new, ok, theta, _ = jax.lax.while_loop(lm_cond, lm_body, (d, R_new, ok, theta, ok))
         w = jnp.where(ok, s.w + d, s.w)

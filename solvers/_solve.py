@@ -56,12 +56,14 @@ def _choose_algebra(problem: Problem, spec: Spec, method: str):
         )
     sparse = method == "sparse" or (method == "auto" and spec.is_local and spec.n + spec.m > DENSE_LIMIT)
     if sparse:
-        return SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
+        pattern = cached_pattern(spec, problem.x0, problem.params)
+        pattern.symbolic(), pattern.symbolic(augmented=True)  # outside any trace
+        return SparseAlgebra(pattern)
     return DenseAlgebra()
 
 
 @partial(jax.jit, static_argnames=("spec", "algebra", "tol", "max_steps", "first_order", "newton_phase"))
-def _solve_jit(spec, algebra, arrays, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
+def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
     z0_, params_ = jax.lax.stop_gradient((z0, params))
     kkt = KKT(spec, z0_, params_)
     u0 = z0_[spec.layout.free]
@@ -70,14 +72,14 @@ def _solve_jit(spec, algebra, arrays, z0, params, lam0, weights, *, tol, max_ste
         grad_e = jax.grad(kkt.energy)(u0)
         w_probe = jnp.concatenate([u0, jnp.zeros((spec.m,), u0.dtype)])
         rhs = jnp.concatenate([grad_e, jnp.zeros((spec.m,), u0.dtype)])
-        lam0 = -algebra.solve(kkt, arrays, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
+        lam0 = -algebra.solve(kkt, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
         lam0 = jnp.where(jnp.isfinite(lam0), lam0, 0.0)
     w = jnp.concatenate([u0, lam0])
     fo_steps = jnp.asarray(0)
     if first_order:
         w, fo_steps, _ = augmented_lagrangian(kkt, w, weights, tol=tol, outer_steps=first_order)
     if newton_phase:
-        state = newton(kkt, algebra, arrays, w, weights, tol=tol, max_steps=max_steps)
+        state = newton(kkt, algebra, w, weights, tol=tol, max_steps=max_steps)
         w, residual, steps, history, status = state.w, state.residual, state.step, state.history, state.status
     else:
         residual = scaled_residual(kkt.residual(w), weights, spec.n)
@@ -85,7 +87,7 @@ def _solve_jit(spec, algebra, arrays, z0, params, lam0, weights, *, tol, max_ste
         finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
         status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
 
-    w = implicit_solution(spec, algebra, arrays, w, z0, params)
+    w = implicit_solution(spec, algebra, w, z0, params)
     kkt_diff = KKT(spec, z0, params)
     u, lam = kkt_diff.split(w)
     x = kkt_diff.x(u)
@@ -148,7 +150,7 @@ def solve(
     first_order = FIRST_ORDER_OUTER if warm_start == "lbfgs" else (int(max_steps) if method == "lbfgs" else 0)
     try:
         sol = _solve_jit(
-            spec, algebra, algebra.arrays(), z0, problem.params, lam0, residual_weights(problem, spec),
+            spec, algebra, z0, problem.params, lam0, residual_weights(problem, spec),
             tol=float(tol), max_steps=int(max_steps), first_order=first_order, newton_phase=method != "lbfgs",
         )
     except jax.errors.JaxRuntimeError as err:  # KLU reports an exactly singular matrix this way

@@ -44,21 +44,35 @@ class SparsePattern:
     def nnz(self) -> int:
         return int(self.rows.size)
 
-    def augmented(self) -> tuple[np.ndarray, np.ndarray]:
-        """COO indices of the Levenberg–Marquardt matrix `[[I, K], [Kᵀ, −νI]]` (values: 1, K, K, −ν)."""
-        size = self.n + self.m
-        diag = np.arange(size)
-        rows = np.concatenate([diag, self.rows, size + self.cols, size + diag])
-        cols = np.concatenate([diag, size + self.cols, self.rows, size + diag])
-        return rows.astype(np.int32), cols.astype(np.int32)
+    def symbolic(self, augmented: bool = False):
+        """KLU's symbolic analysis (ordering) of the KKT or LM matrix, made once and kept here.
 
-    def arrays(self) -> dict:
-        """The index arrays as jax arrays (made once, then reused)."""
-        if "_arrays" not in self.__dict__:
-            arrays = {k: jnp.asarray(getattr(self, k)) for k in ("rows", "cols", "source", "target")}
-            arrays["aug_rows"], arrays["aug_cols"] = (jnp.asarray(a) for a in self.augmented())
-            self.__dict__["_arrays"] = arrays
-        return self.__dict__["_arrays"]
+        Made outside any trace and kept alive by this pattern, which `jit`'s cache holds
+        through the static `SparseAlgebra`; every factorisation then skips the ordering.
+        """
+        import klujax
+
+        key = "_symbolic_aug" if augmented else "_symbolic"
+        if key not in self.__dict__:
+            rows, cols = self.augmented()[:2] if augmented else (self.rows, self.cols)
+            size = (self.n + self.m) * (2 if augmented else 1)
+            self.__dict__[key] = klujax.analyze(jnp.asarray(rows), jnp.asarray(cols), size)
+        return self.__dict__[key]
+
+    def augmented(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Sorted COO indices of the Levenberg–Marquardt matrix `[[I, K], [Kᵀ, −νI]]`.
+
+        Returns `(rows, cols, order)`: the values in the order (1…, K, K, −ν…) go to
+        `values[order]`.
+        """
+        if "_augmented" not in self.__dict__:
+            size = self.n + self.m
+            diag = np.arange(size)
+            rows = np.concatenate([diag, self.rows, size + self.cols, size + diag])
+            cols = np.concatenate([diag, size + self.cols, self.rows, size + diag])
+            order = np.lexsort((cols, rows))
+            self.__dict__["_augmented"] = (rows[order].astype(np.int32), cols[order].astype(np.int32), order)
+        return self.__dict__["_augmented"]
 
 
 def _columns(term: Term, width: int, n_rows: int) -> np.ndarray:

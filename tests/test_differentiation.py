@@ -8,7 +8,7 @@ import ddgjax as dg
 from solvers import solve
 
 from conftest import tree_max_abs_diff
-from problems import nearest_point_on_sphere, random_symmetric, unit_chain
+from solvers.problems import nearest_point_on_sphere, random_symmetric, unit_chain
 
 
 def _central_difference(f, p, h=1e-6):

@@ -12,7 +12,7 @@ import pytest
 import ddgjax as dg
 from solvers import solve
 
-from problems import random_symmetric, rayleigh, unit_chain
+from solvers.problems import random_symmetric, rayleigh, unit_chain
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
@@ -178,7 +178,7 @@ def test_auto_uses_sparse_path_for_large_local_problems():
 
 
 def test_lbfgs_method_solves_minimisation_alone():
-    from problems import nearest_point_on_sphere
+    from solvers.problems import nearest_point_on_sphere
 
     c = np.array([1.0, 2.0, -0.5])
     sol = solve(nearest_point_on_sphere(c, 1.5), method="lbfgs", tol=1e-9)
@@ -201,3 +201,22 @@ def test_residual_scale_is_applied():
     plain = solve(rayleigh(A, x0), max_steps=2, throw=False)
     scaled = solve(rayleigh(A, x0, residual_scale=(1e-3, 1e-3)), max_steps=2, throw=False)
     np.testing.assert_allclose(float(scaled.residual), 1e-3 * float(plain.residual), rtol=1e-12)
+
+
+def test_klu_solve_with_sorted_indices_matches_dense():
+    """Our direct use of KLU (pre-sorted indices, reused symbolic analysis) solves K x = b."""
+    from solvers._kkt import KKT, spec_of
+    from solvers._linear import SparseAlgebra
+    from solvers._sparse import build_pattern
+
+    problem = unit_chain(9, chord=(7.5, 3.5, 0.2))
+    spec = spec_of(problem)
+    algebra = SparseAlgebra(build_pattern(spec, problem.x0, problem.params))
+    kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
+    rng = np.random.default_rng(3)
+    w, b = (jnp.asarray(rng.normal(size=spec.n + spec.m)) for _ in range(2))
+    x = algebra.solve(kkt, w, 0.0, b)
+    K = np.asarray(jax.hessian(kkt.lagrangian)(w))
+    assert np.max(np.abs(K @ np.asarray(x) - np.asarray(b))) <= 1e-10
+    d = algebra.lm_solve(kkt, w, 0.3, b)  # (KᵀK + νI) d = −Kᵀ b
+    assert np.max(np.abs((K.T @ K + 0.3 * np.eye(len(K))) @ np.asarray(d) + K.T @ np.asarray(b))) <= 1e-10

@@ -1,4 +1,6 @@
-"""Small test problems with known answers, shared by the solver tests."""
+"""Reference problems with known answers, for tests and benchmarks of `solve`.
+
+They are generic (vectors on spheres, quadratic forms), not objects of the catalogue."""
 
 import jax.numpy as jnp
 import numpy as np
@@ -46,11 +48,12 @@ def nearest_point_on_sphere(c, r) -> dg.Problem:
     )
 
 
-def unit_chain(n: int, *, field=(0.03, -0.02, 0.05), chord=None, local=True, seed=0, noise=0.05,
+def unit_chain(n: int, *, field=(1.0, -0.5, 2.0), chord=None, local=True, seed=0, noise=0.05,
                turn=1.0) -> dg.Problem:
     """Unit vectors X_0..X_{n-1} with a nearest-neighbour coupling and a weak field.
 
-    E = n Σ_k (1 − <X_k, X_{k+1}>) + Σ_k <f, X_k>,  |X_k|² = 1 for the free k, and optionally
+    E = n Σ_k (1 − <X_k, X_{k+1}>) + (1/n) Σ_k <f, X_k>  (h = 1/n: a discretisation of
+    ∫|X'|²/2 + <f, X>, so the answer has a smooth limit and Newton's step count does not grow),  |X_k|² = 1 for the free k, and optionally
     Σ_k X_k = chord.  X_0 = e1 and X_{n-1} = (cos turn, sin turn, 0) are fixed; the start is
     the normalised linear interpolation plus noise.  Declared local (dg.local_sum /
     dg.local_map) or as plain functions.
@@ -71,7 +74,7 @@ def unit_chain(n: int, *, field=(0.03, -0.02, 0.05), chord=None, local=True, see
         return n * (1.0 - X2[0] @ X2[1])
 
     def potential(X1, _):
-        return f @ X1[0]
+        return f @ X1[0] / n
 
     def unit(X1, _):
         return X1[0] @ X1[0] - 1.0
@@ -86,7 +89,7 @@ def unit_chain(n: int, *, field=(0.03, -0.02, 0.05), chord=None, local=True, see
             cons = dg.concat(cons, dg.local_sum(chord_term, np.arange(n)[:, None]))
     else:
         def energy(X, _):
-            return n * jnp.sum(1.0 - jnp.sum(X[:-1] * X[1:], axis=1)) + jnp.sum(X @ f)
+            return n * jnp.sum(1.0 - jnp.sum(X[:-1] * X[1:], axis=1)) + jnp.sum(X @ f) / n
 
         def cons(X, c):
             unit_part = jnp.sum(X[1:-1] ** 2, axis=1) - 1.0
