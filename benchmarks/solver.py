@@ -124,8 +124,10 @@ def time_scipy(problem, repeats: int):
     return {"solve": statistics.median(times), "residual": runner.kkt_residual(res.x), "steps": int(res.nit)}
 
 
-def fmt(x, spec):
-    return "—" if x is None else format(x, spec)
+def ratio_text(ratio) -> str:
+    if ratio is None:
+        return "—"
+    return f"{ratio:.1f}×" if ratio < 10 else f"{ratio:.0f}×"
 
 
 def main(argv=None):
@@ -150,7 +152,7 @@ def main(argv=None):
         for path, r in rows:
             ratio = None if scipy_row is None else scipy_row["solve"] / r["solve"]
             print(f"| {n_free} | ddgjax {path} | {r['compile']:.2f} | {r['solve']:.4f} | {r['steps']} | "
-                  f"{r['residual']:.1e} | {fmt(ratio, '.0f')}× |")
+                  f"{r['residual']:.1e} | {ratio_text(ratio)} |")
         if scipy_row is not None:
             print(f"| {n_free} | scipy trust-constr | — | {scipy_row['solve']:.3f} | {scipy_row['steps']} | "
                   f"{scipy_row['residual']:.1e} | 1× |")

@@ -166,7 +166,7 @@ def test_sparse_kkt_matrix_equals_dense_hessian():
     assert np.max(np.abs(K - dense)) <= 1e-12
 
 
-def test_auto_uses_sparse_path_for_large_local_problems():
+def test_auto_uses_sparse_path_for_local_problems():
     from solvers._linear import SparseAlgebra
     from solvers._solve import _choose_algebra
     from solvers._kkt import spec_of
@@ -220,3 +220,43 @@ def test_klu_solve_with_sorted_indices_matches_dense():
     assert np.max(np.abs(K @ np.asarray(x) - np.asarray(b))) <= 1e-10
     d = algebra.lm_solve(kkt, w, 0.3, b)  # (KᵀK + νI) d = −Kᵀ b
     assert np.max(np.abs((K.T @ K + 0.3 * np.eye(len(K))) @ np.asarray(d) + K.T @ np.asarray(b))) <= 1e-10
+
+
+def test_finds_saddle_points_not_only_minima():
+    """On the sphere the middle eigenvectors of A are saddles of xᵀAx; Newton converges to the
+    one it starts near (the merit is |R|, not E)."""
+    A = np.diag([1.0, 2.0, 3.0, 4.0, 5.0])
+    x0 = np.array([0.05, 0.1, 1.0, -0.08, 0.02])
+    sol = solve(rayleigh(A, x0))
+    assert float(sol.residual) <= 1e-10
+    assert abs(float(sol.multipliers[0]) - 3.0) <= 1e-12
+    # second-order check: the Hessian of the Lagrangian on the tangent space is indefinite
+    x = np.asarray(sol.x)
+    tangent = np.linalg.svd(x[None])[2][1:]  # orthonormal basis of x^⊥
+    reduced = tangent @ (2 * A - 2 * float(sol.multipliers[0]) * np.eye(5)) @ tangent.T
+    eig = np.linalg.eigvalsh(reduced)
+    assert eig[0] < -1 and eig[-1] > 1
+
+
+def test_solve_inside_jit_returns_flags_instead_of_raising():
+    from solvers.problems import nearest_point_on_sphere
+
+    @jax.jit
+    def radius_residual(r):
+        sol = solve(nearest_point_on_sphere(np.array([1.0, 2.0, 2.0]), r))
+        return jnp.linalg.norm(sol.x), sol.converged
+
+    norm, converged = radius_residual(2.5)
+    assert bool(converged) and abs(float(norm) - 2.5) <= 1e-12
+
+
+def test_repeated_solves_reuse_the_compiled_solver():
+    """Problems built from the same functions and shapes share one compilation."""
+    from solvers._solve import _solve_jit
+
+    A = random_symmetric(8, 0)
+    solve(rayleigh(A, np.ones(8)))
+    before = _solve_jit._cache_size()
+    for seed in range(3):
+        solve(rayleigh(random_symmetric(8, seed), np.random.default_rng(seed).normal(size=8)))
+    assert _solve_jit._cache_size() == before
