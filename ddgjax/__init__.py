@@ -10,8 +10,10 @@ import jax as _jax
 
 _jax.config.update("jax_enable_x64", True)
 
+from . import curves as curves  # noqa: E402
 from . import errors as errors  # noqa: E402
 from . import limits as limits  # noqa: E402
+from . import plot as plot  # noqa: E402
 from .flows import (  # noqa: E402
     gradient_flow as gradient_flow,
     hamiltonian_flow as hamiltonian_flow,

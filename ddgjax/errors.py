@@ -16,6 +16,8 @@ __all__ = [
     "NotScalarError",
     "OverconstrainedError",
     "ConvergenceError",
+    "ArcLengthError",
+    "SingularVertexError",
 ]
 
 
@@ -57,3 +59,17 @@ class ConvergenceError(DDGError, RuntimeError):
         self.residual = residual
         self.steps = steps
         self.solution = solution
+
+
+class ArcLengthError(InvalidInputError):
+    """A curve that must be arc-length parametrised (Def 1.2) has an edge of another length.
+
+    The message names the first offending edge and its length.
+    """
+
+
+class SingularVertexError(InvalidInputError):
+    """A curve is singular at a vertex: successive points coincide (not regular, Def 1.2) or
+    consecutive tangents are anti-parallel (turning angle π), where a formula divides by
+    `1 + <T_k, T_{k-1}> = 0`.  The message names the vertex (or the coinciding vertices).
+    """

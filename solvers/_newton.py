@@ -29,13 +29,15 @@ CONVERGED, MAX_STEPS, STALLED, NONFINITE, RUNNING = 0, 1, 2, 3, -1
 STATUS_TEXT = {
     CONVERGED: "converged",
     MAX_STEPS: "reached max_steps",
-    STALLED: "stalled: no step decreases the residual, even a strongly damped one",
+    STALLED: "stalled: no step decreases the residual (if the residual is tiny, it is at the "
+    "round-off level of float64 for this problem: loosen tol)",
     NONFINITE: "the energy or its derivatives became non-finite",
 }
 
 ARMIJO = 1e-4
 NEWTON_MU = 1e-14
 MIN_NEWTON_STEP = 2.0**-10
+ROUNDOFF = 1e-13
 THETA_START, THETA_MIN, THETA_MAX = 1e-3, 1e-10, 1e12
 
 
@@ -61,7 +63,9 @@ def _newton_trial(kkt: KKT, algebra, w, R):
     `|Δ̄| ≤ (1 − α/4)|Δ|`, for the largest α in {1, ½, …, 2⁻¹⁰}.  Unlike a test on |R| this
     does not depend on how the equations are scaled, so a start with a small residual but far
     from the answer (a field acting on a long chain) still takes long steps.  Near a solution
-    `|Δ̄| = O(|Δ|²)` and α = 1: quadratic convergence.  Returns (α Δ, R(w + αΔ), accepted).
+    `|Δ̄| = O(|Δ|²)` and α = 1: quadratic convergence.  Returns (α Δ, R(w + αΔ), accepted,
+    at_roundoff), the last flag saying that the Newton correction is at the round-off level of
+    w, so that a rejected step means the residual cannot be reduced further in float64.
     """
     fac = algebra.factor(kkt, w, NEWTON_MU)
     delta = algebra.apply(fac, -R)
@@ -83,7 +87,8 @@ def _newton_trial(kkt: KKT, algebra, w, R):
 
     one = jnp.asarray(1.0, w.dtype)
     alpha, R_new, ok = jax.lax.while_loop(cond, body, (one,) + trial(one))
-    return alpha * delta, R_new, ok & jnp.isfinite(size)
+    at_roundoff = jnp.max(jnp.abs(delta)) <= ROUNDOFF * jnp.maximum(1.0, jnp.max(jnp.abs(w)))
+    return alpha * delta, R_new, ok & jnp.isfinite(size), at_roundoff
 
 
 def _lm_trial(kkt: KKT, algebra, w, R, theta):
@@ -113,14 +118,15 @@ def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> New
         return s.status == RUNNING
 
     def body(s: NewtonState) -> NewtonState:
-        d, R_new, ok = _newton_trial(kkt, algebra, s.w, s.R)
+        d, R_new, ok, at_roundoff = _newton_trial(kkt, algebra, s.w, s.R)
         theta = jnp.where(ok, jnp.maximum(s.theta / 4, THETA_MIN), s.theta)
+        stuck = (~ok) & at_roundoff
 
         # "if not ok: LM trial", written as a loop that runs 0 or 1 times rather than lax.cond:
         # under vmap a cond with a batched predicate batches all its operands, incl. the
         # sparse index arrays, which KLU cannot take batched; a while_loop keeps them unbatched.
         def lm_cond(carry):
-            return ~carry[4]
+            return ~carry[4] & ~stuck
 
         def lm_body(carry):
             return _lm_trial(kkt, algebra, s.w, s.R, carry[3]) + (jnp.asarray(True),)
@@ -136,7 +142,11 @@ def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> New
             jnp.where(
                 ~jnp.isfinite(residual),
                 NONFINITE,
-                jnp.where(theta >= THETA_MAX, STALLED, jnp.where(step >= max_steps, MAX_STEPS, RUNNING)),
+                jnp.where(
+                    (theta >= THETA_MAX) | stuck,
+                    STALLED,
+                    jnp.where(step >= max_steps, MAX_STEPS, RUNNING),
+                ),
             ),
         )
         return NewtonState(w, R, residual, theta, step, s.history.at[step].set(residual), status)

@@ -215,10 +215,10 @@ def test_klu_solve_with_sorted_indices_matches_dense():
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
     rng = np.random.default_rng(3)
     w, b = (jnp.asarray(rng.normal(size=spec.n + spec.m)) for _ in range(2))
-    x = algebra.solve(kkt, w, 0.0, b)
-    K = np.asarray(jax.hessian(kkt.lagrangian)(w))
+    x = jax.jit(lambda w, b: algebra.solve(kkt, w, 0.0, b))(w, b)
+    K = np.asarray(jax.jit(jax.hessian(kkt.lagrangian))(w))
     assert np.max(np.abs(K @ np.asarray(x) - np.asarray(b))) <= 1e-10
-    d = algebra.lm_solve(kkt, w, 0.3, b)  # (KᵀK + νI) d = −Kᵀ b
+    d = jax.jit(lambda w, b: algebra.lm_solve(kkt, w, 0.3, b))(w, b)  # (KᵀK + νI) d = −Kᵀ b
     assert np.max(np.abs((K.T @ K + 0.3 * np.eye(len(K))) @ np.asarray(d) + K.T @ np.asarray(b))) <= 1e-10
 
 

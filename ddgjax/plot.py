@@ -1,0 +1,102 @@
+"""Figures of discrete curves and convergence tables (matplotlib, Agg backend).
+
+matplotlib is imported and switched to the non-interactive Agg backend inside each function,
+never when ddgjax is imported.  Each function returns the figure, or, when `path` is given,
+saves it there, closes it and returns `path`.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .curves import Curve, _as_curve
+from .errors import InvalidInputError
+from .limits import ConvergenceTable
+
+__all__ = ["curve", "curves", "convergence"]
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _axes(ax, dim: int):
+    """`ax` or a new figure's axes, 3-D for space curves."""
+    if ax is not None:
+        return ax
+    fig = _pyplot().figure(figsize=(4.5, 4.0))
+    return fig.add_subplot(projection="3d" if dim == 3 else None)
+
+
+def _polyline(gamma, closed: bool) -> np.ndarray:
+    """The vertices as a numpy array, with the first repeated at the end of a closed curve."""
+    points = np.asarray(_as_curve(gamma, closed))
+    return np.vstack([points, points[:1]]) if closed else points
+
+
+def _finish(ax, path):
+    fig = ax.figure
+    if ax.name != "3d":
+        ax.set_aspect("equal", adjustable="datalim")
+    if path is None:
+        return fig
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    _pyplot().close(fig)
+    return path
+
+
+def curve(gamma: Curve, ax=None, closed: bool = False, *, path=None, vertices: bool = True, **kw):
+    """Draw one polyline, (N, 2) in the plane or (N, 3) in space; `kw` go to `ax.plot`.
+
+    `vertices=True` marks the vertices.  Returns the figure, or `path` after saving there.
+    """
+    points = _polyline(gamma, closed)
+    ax = _axes(ax, points.shape[1])
+    kw.setdefault("marker", "o" if vertices else None)
+    kw.setdefault("markersize", 2.5)
+    ax.plot(*points.T, **kw)
+    return _finish(ax, path)
+
+
+def curves(
+    gammas: Sequence[Curve],
+    ax=None,
+    closed: bool = False,
+    *,
+    path=None,
+    cmap: str = "viridis",
+    labels: Sequence[str] | None = None,
+    **kw,
+):
+    """Draw a family of polylines (e.g. elastica at increasing load), coloured along `cmap`.
+
+    All curves must have the same dimension.  `labels` (one per curve) adds a legend; `kw` go to
+    `ax.plot`.  Returns the figure, or `path` after saving there.
+    """
+    polylines = [_polyline(gamma, closed) for gamma in gammas]
+    if not polylines:
+        raise InvalidInputError("curves: the family is empty, nothing to draw")
+    ax = _axes(ax, polylines[0].shape[1])
+    colours = _pyplot().get_cmap(cmap)(np.linspace(0.0, 1.0, max(len(polylines), 2)))
+    for i, points in enumerate(polylines):
+        label = None if labels is None else labels[i]
+        ax.plot(*points.T, color=colours[i], label=label, **kw)
+    if labels is not None:
+        ax.legend(fontsize="small")
+    return _finish(ax, path)
+
+
+def convergence(table: ConvergenceTable, path, *, title: str | None = None):
+    """Log-log plot of a `ddgjax.limits.ConvergenceTable` with its fitted slope; saves `path`.
+
+    The same figure as `table.plot(path)`; returns `path`.
+    """
+    return table.plot(path, title=title)

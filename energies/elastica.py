@@ -1,0 +1,266 @@
+"""Discrete elastica (Def 3.2, Thm 3.8, Cor 3.9, Remark 3.7): the bending energy of an arc-length
+polygon, declared as a functional of its unit edge tangents.
+
+**Energy.**  With edge length h = L/n and unit tangents T_0 … T_{n−1}, the local bending energy
+at an interior vertex is (Sec 3.3, Def 3.2)
+
+    E_k = log(1 + κ_k²/4),   κ_k = 2 tan(φ_k/2) = 2 |T_k − T_{k−1}| / |T_k + T_{k−1}|,
+
+equal on unit vectors to log 2 − log(1 + <T_k, T_{k−1}>).  We evaluate the first form: its
+gradient is O(h) with no O(1) terms cancelling against the unit-length multipliers, so the
+KKT residual can be driven to ~ε/h instead of ~ε/h² (it matters from n ≈ 10³ on).
+
+and the problem's energy is `(2/h) Σ_k E_k`, which tends to `½ ∫ κ² ds` (κ_k/h → κ).  The
+scale does not change the critical points; it makes the multipliers converge (below), and it
+is how the KKT residual is scaled with the discretisation: the gradient with respect to T_k is
+then the integral over edge k of the pointwise Euler–Lagrange residual `−T'' + cT + … ` (the
+weak residual), so `tol` bounds the same quantity at every n.  (Dividing further by h, to the
+pointwise residual, would put its float64 round-off floor, ~ε/h², above 1e-10 from n ≈ 10³.)
+
+**Constraints.**  |T_k|² − 1 = 0 for every free edge, and the chord `c − h Σ_k T_k = 0`
+(Remark 3.7: factorising translations, the end points become the chord).  Constraint order:
+the unit constraints of the free edges in edge order, then the three chord components.
+
+**Clamps.**  `clamp="edge"` is Def 3.2: T_0 and T_{n−1} are fixed.  It prescribes the tangent of
+the first *edge*, i.e. of the smooth curve at s = h/2, so the discrete curve is only O(h) close
+to the smooth clamped elastica.  `clamp="vertex"` prescribes the tangent at the end *vertex*:
+T_0 and T_{n−1} are free and the end vertex gets a bending term at half weight with a ghost
+edge, the mirror image of T_0 in the line of `t_start` (of T_{n−1} in `t_end`), so that the
+vertex tangent T_0 + T_{−1} is `t_start` — a second-order boundary condition, O(h²).
+
+**Multipliers and Theorem 3.8.**  The chord multipliers λ converge to the smooth load `a` of
+Thm 3.2 (`T'' = c T + a`): `load(solution)` returns them.  Thm 3.8 (with its typo fixed: the
+denominator is 1 + <T_k, T_{k−1}>) holds in the form
+
+    T_k × T_{k−1} / (1 + <T_k, T_{k−1}>) = a_h × γ_k + b,   a_h = (h/2) λ,
+
+at every interior vertex of the curve γ = from_tangents(T, edge_length=h); `theorem_3_8_a`.
+The discrete spherical pendulum (Def 3.3, Thm 3.10) of the same tangents has gravity
+`(h²/2) λ` (`pendulum_gravity`).
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+import ddgjax as dg
+from ddgjax.errors import InvalidInputError, ShapeError
+
+__all__ = [
+    "bending_density",
+    "bending_energy",
+    "clamped",
+    "closed",
+    "load",
+    "resample",
+    "theorem_3_8_a",
+    "pendulum_gravity",
+    "edge_length",
+    "curve",
+    "InfeasibleChordError",
+]
+
+
+class InfeasibleChordError(InvalidInputError):
+    """The prescribed chord is longer than the curve: no arc-length curve realises it."""
+
+
+def bending_density(T_prev: Float[Array, "3"], T_next: Float[Array, "3"]) -> Float[Array, ""]:
+    """`E_k = log(1 + κ_k²/4)` with `κ_k/2 = tan(φ_k/2) = |T_k − T_{k−1}| / |T_k + T_{k−1}|` (Def 3.2).
+
+    On unit vectors this equals `dg.curves.local_bending_energy` (`log 2 − log(1 + <T_k,
+    T_{k−1}>)`), whose extension off the sphere defines the flows of Prop 2.1/2.2; this
+    extension is the one with the better round-off (module docstring).  Infinite at a
+    singular vertex (φ = π).
+    """
+    d, s = T_next - T_prev, T_next + T_prev
+    return jnp.log1p(jnp.dot(d, d) / jnp.dot(s, s))
+
+
+def bending_energy(T: Float[Array, "n 3"], closed: bool = False) -> Float[Array, ""]:
+    """`Σ_k E_k` over the interior vertices (all vertices if `closed`): Def 3.2's functional."""
+    T = jnp.asarray(T)
+    previous = jnp.roll(T, 1, axis=0) if closed else T[:-1]
+    following = T if closed else T[1:]
+    return jnp.sum(jax.vmap(bending_density)(previous, following))
+
+
+# Densities of the declaration: module-level functions, so that every problem of the same size
+# shares one compiled solver (parameters carry h, the chord and the clamps).
+
+
+def _bend(T2, p):
+    return (2.0 / p["h"]) * bending_density(T2[0], T2[1])
+
+
+def _mirrored(T, t):
+    """The mirror image of T in the line of the unit vector t: 2<T, t> t − T."""
+    return 2.0 * jnp.dot(T, t) * t - T
+
+
+def _ghost_bend(T1, which, p):
+    """Half the bending term of an end vertex with a ghost edge mirrored in the clamp tangent."""
+    t = jnp.where(which == 0, p["t_start"], p["t_end"])
+    return 0.5 * (2.0 / p["h"]) * bending_density(_mirrored(T1[0], t), T1[0])
+
+
+def _unit(T1, _):
+    return jnp.dot(T1[0], T1[0]) - 1.0
+
+
+def _chord(T1, share, p):
+    return share * p["chord"] - p["h"] * T1[0]
+
+
+def edge_length(problem: dg.Problem) -> float:
+    return problem.params["h"]
+
+
+def _unit_vector(v, name: str) -> np.ndarray:
+    v = np.array(v, dtype=float)
+    if v.shape != (3,):
+        raise ShapeError(f"{name} must be a vector of shape (3,), got {v.shape}")
+    norm = np.linalg.norm(v)
+    if not np.isfinite(norm) or norm == 0:
+        raise InvalidInputError(f"{name} must be a finite non-zero vector, got {v}")
+    return v / norm
+
+
+def _slerp(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+    angle = np.arccos(np.clip(a @ b, -1.0, 1.0))
+    if angle < 1e-12:
+        return np.broadcast_to(a, (len(s), 3)).copy()
+    if np.pi - angle < 1e-9:  # antipodal: go through any perpendicular direction
+        perp = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+        mid = perp / np.linalg.norm(perp)
+        return np.concatenate([_slerp(a, mid, s[s < 0.5] * 2), _slerp(mid, b, s[s >= 0.5] * 2 - 1)])
+    return (np.sin((1 - s)[:, None] * angle) * a + np.sin(s[:, None] * angle) * b) / np.sin(angle)
+
+
+def initial_tangents(n: int, length: float, chord, t_start, t_end) -> np.ndarray:
+    """A rough start: the great-circle interpolation of the end tangents, shifted by a constant
+    vector and renormalised so that its mean matches chord/length (a few fixed-point steps)."""
+    T = _slerp(np.asarray(t_start), np.asarray(t_end), np.linspace(0.0, 1.0, n))
+    target = np.asarray(chord) / length
+    shift = np.zeros(3)
+    for _ in range(50):
+        U = T + shift
+        U /= np.linalg.norm(U, axis=1, keepdims=True)
+        shift += target - U.mean(axis=0)
+    return U
+
+
+def clamped(
+    n: int,
+    *,
+    length: float = 1.0,
+    chord,
+    t_start,
+    t_end,
+    clamp: str = "edge",
+    x0=None,
+) -> dg.Problem:
+    """A clamped discrete elastica: n unit edge tangents `T` (n, 3), length L, chord c.
+
+    Critical points of `(2/h) Σ E_k` (Def 3.2) on `{|T_k| = 1, h Σ T_k = chord}` with the ends
+    clamped (`clamp="edge"`: T_0 = t_start, T_{n−1} = t_end; `clamp="vertex"`: the end vertex
+    tangents, see the module docstring).  The curve is `curve(T, problem)`.
+
+    **Raises:** `InfeasibleChordError` if |chord| ≥ length (only the straight segment, or
+    nothing, is left); `InvalidInputError`/`ShapeError` for bad n, clamps or vectors;
+    `NonFiniteError` for NaN in `x0`.
+    """
+    if int(n) < 3:
+        raise InvalidInputError(f"a clamped elastica needs at least 3 edges, got n = {n}")
+    if clamp not in ("edge", "vertex"):
+        raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
+    if not (length > 0):
+        raise InvalidInputError(f"length must be positive, got {length}")
+    chord = np.array(chord, dtype=float)
+    if chord.shape != (3,) or not np.all(np.isfinite(chord)):
+        raise ShapeError(f"chord must be a finite vector of shape (3,), got {chord}")
+    if np.linalg.norm(chord) >= length:
+        raise InfeasibleChordError(
+            f"the chord |γ_n − γ_0| = {np.linalg.norm(chord):.6g} is not shorter than the length "
+            f"{length:.6g}: no bent arc-length curve has it (infeasible)"
+        )
+    t_start, t_end = _unit_vector(t_start, "t_start"), _unit_vector(t_end, "t_end")
+    n, h = int(n), float(length) / int(n)
+    T0 = initial_tangents(n, length, chord, t_start, t_end) if x0 is None else np.array(x0, dtype=float)
+    if T0.shape != (n, 3):
+        raise ShapeError(f"x0 must have shape ({n}, 3), got {T0.shape}")
+    edges = np.arange(n)
+    energy = dg.local_sum(_bend, np.stack([edges[:-1], edges[1:]], axis=1))
+    fixed = np.zeros((n, 3), bool)
+    if clamp == "edge":
+        T0 = T0.copy()
+        T0[0], T0[-1] = t_start, t_end
+        fixed[[0, -1]] = True
+        free_edges = edges[1:-1]
+    else:
+        energy = energy + dg.local_sum(_ghost_bend, np.array([[0], [n - 1]]), data=np.array([0, 1]))
+        free_edges = edges
+    constraints = dg.concat(
+        dg.local_map(_unit, free_edges[:, None]),
+        dg.local_sum(_chord, edges[:, None], data=np.full(n, 1.0 / n)),
+    )
+    params = {"h": h, "chord": jnp.asarray(chord), "t_start": jnp.asarray(t_start), "t_end": jnp.asarray(t_end)}
+    return dg.Problem(
+        energy, T0, constraints=constraints, params=params, fixed=fixed,
+        name=f"clamped elastica (n={n}, clamp={clamp})",
+    )
+
+
+def closed(n: int, *, length: float = 1.0, x0) -> dg.Problem:
+    """A closed discrete elastica (Remark 3.7): n unit tangents with Σ T_k = 0 and the bending
+    energy summed over all n vertices.  Critical points include the regular n-gon (the minimum)
+    and Euler's figure-eight (a saddle).  Rotations act freely: the KKT matrix is singular."""
+    n, h = int(n), float(length) / int(n)
+    T0 = np.array(x0, dtype=float)
+    if T0.shape != (n, 3):
+        raise ShapeError(f"x0 must have shape ({n}, 3), got {T0.shape}")
+    edges = np.arange(n)
+    energy = dg.local_sum(_bend, np.stack([np.roll(edges, 1), edges], axis=1))
+    constraints = dg.concat(
+        dg.local_map(_unit, edges[:, None]),
+        dg.local_sum(_chord, edges[:, None], data=np.full(n, 1.0 / n)),
+    )
+    params = {"h": h, "chord": jnp.zeros(3), "t_start": jnp.zeros(3), "t_end": jnp.zeros(3)}
+    return dg.Problem(
+        energy, T0, constraints=constraints, params=params,
+        name=f"closed elastica (n={n})",
+    )
+
+
+def resample(T: Float[Array, "n 3"], n: int) -> Float[Array, "m 3"]:
+    """Tangents of an n-edge curve of the same length from those of another one: linear
+    interpolation in arc length between edge midpoints, renormalised.  A start for refining a
+    solved elastica (continuation in n), where Newton then needs two or three steps."""
+    T = np.asarray(T, dtype=float)
+    old = (np.arange(len(T)) + 0.5) / len(T)
+    new = (np.arange(n) + 0.5) / n
+    U = np.stack([np.interp(new, old, T[:, i]) for i in range(T.shape[1])], axis=1)
+    return U / np.linalg.norm(U, axis=1, keepdims=True)
+
+
+def load(solution) -> Float[Array, "3"]:
+    """The chord multipliers λ: they converge to the smooth load a of `T'' = cT + a` (Thm 3.2)."""
+    return solution.multipliers[-3:]
+
+
+def theorem_3_8_a(solution, problem: dg.Problem) -> Float[Array, "3"]:
+    """The vector a of Thm 3.8 for the curve with edge length h: a = (h/2) λ."""
+    return 0.5 * problem.params["h"] * load(solution)
+
+
+def pendulum_gravity(solution, problem: dg.Problem) -> Float[Array, "3"]:
+    """Gravity of the discrete spherical pendulum traced by the tangents (Thm 3.10): (h²/2) λ."""
+    return 0.5 * problem.params["h"] ** 2 * load(solution)
+
+
+def curve(T: Float[Array, "n 3"], problem: dg.Problem, start=(0.0, 0.0, 0.0)) -> Float[Array, "n1 3"]:
+    """The vertices γ_0 … γ_n of the polygon with edges h T_k (γ_0 = start)."""
+    return dg.curves.from_tangents(T, start=start, edge_length=problem.params["h"])
