@@ -98,6 +98,7 @@ class SparseAlgebra:
 
     def __init__(self, pattern: SparsePattern):
         self.pattern = pattern
+        pattern.symbolic(), pattern.symbolic(augmented=True)  # KLU's analyses, outside any trace
 
     def __hash__(self):
         return id(self.pattern)

@@ -57,9 +57,7 @@ def _choose_algebra(problem: Problem, spec: Spec, method: str):
     # 2.6 ms, benchmarks/solver.py), so a declared-local problem always takes the sparse path.
     sparse = method == "sparse" or (method == "auto" and spec.is_local and jax.default_backend() == "cpu")
     if sparse:
-        pattern = cached_pattern(spec, problem.x0, problem.params)
-        pattern.symbolic(), pattern.symbolic(augmented=True)  # outside any trace
-        return SparseAlgebra(pattern)
+        return SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
     return DenseAlgebra()
 
 
