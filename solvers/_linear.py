@@ -87,10 +87,25 @@ def _klu_solve(rows, cols, values, b, symbolic):
     import klujax
 
     handle = jnp.asarray(symbolic.raw, dtype=jnp.uint64)
+    rhs = b.reshape(1, b.shape[0], -1)  # (n_lhs = 1, n_col, n_rhs)
     x = klujax.solve_with_symbol_f64.bind(
-        jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], b[None, :, None], handle
+        jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], rhs, handle
     )
     return x.reshape(b.shape)
+
+
+def _bordered_solve(split, values, b):
+    """Solve `[[A, B], [Bᵗ, C]] x = b` through the Schur complement of the border (`Bordered`)."""
+    n_in, p = len(split.interior), len(split.border)
+    B = jnp.zeros((n_in, p)).at[split.b_rows, split.b_cols].add(values[split.take_b])
+    Bt = jnp.zeros((p, n_in)).at[split.bt_rows, split.bt_cols].add(values[split.take_bt])
+    C = jnp.zeros((p, p)).at[split.c_rows, split.c_cols].add(values[split.take_c])
+    rhs = jnp.concatenate([b[split.interior][:, None], B], axis=1)
+    Y = _klu_solve(split.a_rows, split.a_cols, values[split.take_a], rhs, split.symbolic())
+    schur = C - Bt @ Y[:, 1:]
+    x_border = jnp.linalg.solve(schur, b[split.border] - Bt @ Y[:, 0])
+    x_interior = Y[:, 0] - Y[:, 1:] @ x_border
+    return jnp.zeros_like(b).at[split.interior].set(x_interior).at[split.border].set(x_border)
 
 
 class SparseAlgebra:
@@ -98,7 +113,10 @@ class SparseAlgebra:
 
     def __init__(self, pattern: SparsePattern):
         self.pattern = pattern
-        pattern.symbolic(), pattern.symbolic(augmented=True)  # KLU's analyses, outside any trace
+        # KLU's analyses, made here, outside any trace
+        for augmented in (False, True):
+            if pattern.split(augmented) is None:
+                pattern.symbolic(augmented)
 
     def __hash__(self):
         return id(self.pattern)
@@ -122,6 +140,9 @@ class SparseAlgebra:
         return self._values(kkt, w, jnp.maximum(mu_rel, MU_FLOOR), identity_hessian)
 
     def apply(self, fac, b):
+        split = self.pattern.split()
+        if split is not None:
+            return _bordered_solve(split, fac, b)
         return _klu_solve(self.pattern.rows, self.pattern.cols, fac, b, self.pattern.symbolic())
 
     def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
@@ -133,4 +154,7 @@ class SparseAlgebra:
         aug = jnp.concatenate([jnp.ones((size,)), values, values, jnp.full((size,), -nu)])
         rhs = jnp.concatenate([-R, jnp.zeros_like(R)])
         rows, cols, order = self.pattern.augmented()
+        split = self.pattern.split(augmented=True)
+        if split is not None:
+            return _bordered_solve(split, aug[order], rhs)[size:]
         return _klu_solve(rows, cols, aug[order], rhs, self.pattern.symbolic(augmented=True))[size:]

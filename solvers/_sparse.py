@@ -39,10 +39,26 @@ class SparsePattern:
     cols: np.ndarray  # (nnz,) int32
     source: np.ndarray  # (n_raw,) int32: index into the raw block values
     target: np.ndarray  # (n_raw + n + m,) int32: coalesced entry of each raw value and diagonal
+    coupled: np.ndarray  # KKT indices of the multipliers of global sums (e.g. a chord)
 
     @property
     def nnz(self) -> int:
         return int(self.rows.size)
+
+    def split(self, augmented: bool = False) -> Bordered | None:
+        """The KKT (or LM) matrix split at the coupled multipliers; None if there are none."""
+        if not self.coupled.size:
+            return None
+        key = "_split_aug" if augmented else "_split"
+        if key not in self.__dict__:
+            size = self.n + self.m
+            if augmented:
+                rows, cols = self.augmented()[:2]
+                self.__dict__[key] = bordered(rows, cols, np.concatenate([self.coupled, size + self.coupled]), 2 * size)
+            else:
+                self.__dict__[key] = bordered(self.rows, self.cols, self.coupled, size)
+            self.__dict__[key].symbolic()
+        return self.__dict__[key]
 
     def symbolic(self, augmented: bool = False):
         """KLU's symbolic analysis (ordering) of the KKT or LM matrix, made once and kept here.
@@ -73,6 +89,67 @@ class SparsePattern:
             order = np.lexsort((cols, rows))
             self.__dict__["_augmented"] = (rows[order].astype(np.int32), cols[order].astype(np.int32), order)
         return self.__dict__["_augmented"]
+
+
+@dataclass(frozen=True, eq=False)
+class Bordered:
+    """A sparse matrix `[[A, B], [Bᵗ, C]]` split at a few coupled indices (the border).
+
+    A constraint that sums over all cells (a chord, a closure) fills a whole row and column of
+    the KKT matrix; LU with pivoting turns such rows into catastrophic fill (0.2 s instead of
+    5 ms for n = 2,000 elastica edges).  Eliminating the border by its Schur complement keeps
+    the factorised block `A` banded:  `A Y = [b_A, B]`,  `S = C − Bᵗ Y_B`,
+    `x_C = S⁻¹ (b_C − Bᵗ y_b)`,  `x_A = y_b − Y_B x_C` — one KLU factorisation with
+    1 + (border size) right-hand sides, and a tiny dense solve.
+
+    Index arrays refer to the coalesced COO values of the whole matrix (`take_*`) and to the
+    compact numbering of the interior (`interior`) and the border (`border`).
+    """
+
+    size: int
+    interior: np.ndarray
+    border: np.ndarray
+    a_rows: np.ndarray  # sorted (row, col) COO of A in interior numbering, int32
+    a_cols: np.ndarray
+    take_a: np.ndarray  # value index of each A entry
+    b_rows: np.ndarray  # B: (interior row, border col)
+    b_cols: np.ndarray
+    take_b: np.ndarray
+    bt_rows: np.ndarray  # Bᵗ block: (border row, interior col)
+    bt_cols: np.ndarray
+    take_bt: np.ndarray
+    c_rows: np.ndarray
+    c_cols: np.ndarray
+    take_c: np.ndarray
+
+    def symbolic(self):
+        """KLU's analysis of A, made once (outside any trace) and kept here."""
+        import klujax
+
+        if "_symbolic" not in self.__dict__:
+            self.__dict__["_symbolic"] = klujax.analyze(
+                jnp.asarray(self.a_rows), jnp.asarray(self.a_cols), len(self.interior)
+            )
+        return self.__dict__["_symbolic"]
+
+
+def bordered(rows: np.ndarray, cols: np.ndarray, border: np.ndarray, size: int) -> Bordered:
+    """Split the COO pattern (rows, cols) of a size×size matrix at the indices `border`."""
+    in_border = np.zeros(size, bool)
+    in_border[border] = True
+    interior = np.flatnonzero(~in_border)
+    number = np.empty(size, np.int64)
+    number[interior] = np.arange(len(interior))
+    number[border] = np.arange(len(border))
+    rb, cb = in_border[rows], in_border[cols]
+
+    def block(mask):
+        idx = np.flatnonzero(mask)
+        r, c = number[rows[idx]], number[cols[idx]]
+        order = np.lexsort((c, r))
+        return r[order].astype(np.int32), c[order].astype(np.int32), idx[order]
+
+    return Bordered(size, interior, np.asarray(border), *block(~rb & ~cb), *block(~rb & cb), *block(rb & ~cb), *block(rb & cb))
 
 
 def _columns(term: Term, width: int, n_rows: int) -> np.ndarray:
@@ -158,6 +235,7 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
         cols=(keys % (n + m)).astype(np.int32),
         source=np.concatenate(src_list).astype(np.int32),
         target=target.astype(np.int32),
+        coupled=np.unique([n + r for tp in constraint_terms if tp.term.reduce == "sum" for r in tp.rows[0]]).astype(np.int64),
     )
 
 
