@@ -56,6 +56,7 @@ __all__ = [
     "closed",
     "load",
     "resample",
+    "great_circle",
     "theorem_3_8_a",
     "pendulum_gravity",
     "edge_length",
@@ -129,21 +130,22 @@ def _unit_vector(v, name: str) -> np.ndarray:
     return v / norm
 
 
-def _slerp(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+def great_circle(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Points of the great-circle arc from the unit vector a (s = 0) to b (s = 1), at s (len m)."""
     angle = np.arccos(np.clip(a @ b, -1.0, 1.0))
     if angle < 1e-12:
         return np.broadcast_to(a, (len(s), 3)).copy()
     if np.pi - angle < 1e-9:  # antipodal: go through any perpendicular direction
         perp = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
         mid = perp / np.linalg.norm(perp)
-        return np.concatenate([_slerp(a, mid, s[s < 0.5] * 2), _slerp(mid, b, s[s >= 0.5] * 2 - 1)])
+        return np.concatenate([great_circle(a, mid, s[s < 0.5] * 2), great_circle(mid, b, s[s >= 0.5] * 2 - 1)])
     return (np.sin((1 - s)[:, None] * angle) * a + np.sin(s[:, None] * angle) * b) / np.sin(angle)
 
 
 def initial_tangents(n: int, length: float, chord, t_start, t_end) -> np.ndarray:
     """A rough start: the great-circle interpolation of the end tangents, shifted by a constant
     vector and renormalised so that its mean matches chord/length (a few fixed-point steps)."""
-    T = _slerp(np.asarray(t_start), np.asarray(t_end), np.linspace(0.0, 1.0, n))
+    T = great_circle(np.asarray(t_start), np.asarray(t_end), np.linspace(0.0, 1.0, n))
     target = np.asarray(chord) / length
     shift = np.zeros(3)
     for _ in range(50):

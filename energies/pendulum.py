@@ -26,7 +26,7 @@ import ddgjax as dg
 from ddgjax.errors import InvalidInputError, ShapeError
 from solvers import solve
 
-from .elastica import bending_density
+from .elastica import bending_density, great_circle
 
 __all__ = ["action", "step", "shoot", "kinetic"]
 
@@ -66,9 +66,7 @@ def action(n: int, *, a, T_first, T_last, x0=None) -> dg.Problem:
     n = int(n)
     first, last = _unit_vector(T_first, "T_first"), _unit_vector(T_last, "T_last")
     if x0 is None:
-        from .elastica import _slerp
-
-        T0 = _slerp(first, last, np.linspace(0.0, 1.0, n))
+        T0 = great_circle(first, last, np.linspace(0.0, 1.0, n))
     else:
         T0 = np.array(x0, dtype=float)
         if T0.shape != (n, 3):
