@@ -23,9 +23,9 @@ import numpy as np
 from jax.flatten_util import ravel_pytree
 from jaxtyping import Array, Float
 
-from ._checks import check_finite
+from ._checks import check_finite, is_concrete
 from ._flat import layout_of
-from .errors import InvalidInputError
+from .errors import ConvergenceError, InvalidInputError
 from .problem import Problem, constraint_values
 
 __all__ = ["gradient_flow", "hamiltonian_flow", "spin_poisson", "lie_bracket", "integrate"]
@@ -109,25 +109,35 @@ def gauss_legendre_step(f: Callable, y: jax.Array, h, stages: int = 3, iteration
     """One step of the s-stage Gauss–Legendre method (order 2s) by fixed-point iteration.
 
     Symplectic and exact on quadratic invariants; `stages=1` is the implicit midpoint rule.
-    Iterates `K_i = f(y + h Σ_j a_ij K_j)` until the stage values stop changing.
+    Iterates `K_i = f(y + h Σ_j a_ij K_j)` until the change is at round-off level or stops
+    shrinking.  If it stopped shrinking well above round-off (h·Lipschitz too large: the
+    iteration does not contract) the step returns NaN, which `integrate` reports as an error
+    naming the step.
     """
     A, b = (jnp.asarray(t) for t in _GAUSS[stages])
     K0 = jnp.tile(f(y), (stages, 1))
+    eps = jnp.finfo(y.dtype).eps
 
     def update(K):
         return jax.vmap(f)(y + h * (A @ K))
 
+    def scale(K):
+        return jnp.maximum(1.0, jnp.max(jnp.abs(K)))
+
     def cond(carry):
-        K, change, k = carry
-        return (change > 4 * jnp.finfo(y.dtype).eps * jnp.maximum(1.0, jnp.max(jnp.abs(K)))) & (k < iterations)
+        K, change, previous, k = carry
+        contracting = (change < previous) | (k < 3)
+        return (change > 4 * eps * scale(K)) & contracting & (k < iterations)
 
     def body(carry):
-        K, _, k = carry
+        K, change, _, k = carry
         K_new = update(K)
-        return K_new, jnp.max(jnp.abs(K_new - K)), k + 1
+        return K_new, jnp.max(jnp.abs(K_new - K)), change, k + 1
 
-    K, _, _ = jax.lax.while_loop(cond, body, (K0, jnp.asarray(jnp.inf), 0))
-    return y + h * (b @ K)
+    inf = jnp.asarray(jnp.inf)
+    K, change, _, _ = jax.lax.while_loop(cond, body, (K0, inf, inf, 0))
+    converged = change <= 1e-9 * scale(K)
+    return jnp.where(converged, y + h * (b @ K), jnp.nan)
 
 
 def project(constraints: Callable, y: jax.Array, iterations: int = 4) -> jax.Array:
@@ -177,7 +187,23 @@ def integrate(
         ts, ys = _fixed_steps(fy, y0, float(t1), int(steps), METHODS[method], cy)
     else:
         ts, ys = _adaptive(fy, y0, float(t1), rtol, saves if steps is None else steps + 1, cy)
+    _check_trajectory(ts, ys)
     return ts, jax.vmap(unravel)(ys)
+
+
+def _check_trajectory(ts, ys) -> None:
+    """Never hand back a silent NaN: name the first saved time where the state is not finite."""
+    if not is_concrete(ys):
+        return
+    finite = np.all(np.isfinite(np.asarray(ys)), axis=1)
+    if not finite.all():
+        k = int(np.argmin(finite))
+        raise ConvergenceError(
+            f"integrate: the state became non-finite at saved step {k} (t = {float(ts[k]):.6g}); for "
+            "the Gauss methods this means the implicit stage iteration diverged: the flow is too "
+            "stiff for this step size, use more steps",
+            residual=float("nan"), steps=k,
+        )
 
 
 def _fixed_steps(fy, y0, t1, steps, stages, cy):

@@ -100,3 +100,35 @@ def convergence(table: ConvergenceTable, path, *, title: str | None = None):
     The same figure as `table.plot(path)`; returns `path`.
     """
     return table.plot(path, title=title)
+
+
+def spin_chain(S, ax=None, *, path=None, title: str | None = None):
+    """A closed chain of spins (N, 3) drawn as arrows standing on a ring in the plane z = 0."""
+    S = np.asarray(S)
+    ax = _axes(ax, 3)
+    angle = 2 * np.pi * np.arange(len(S)) / len(S)
+    base = np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=1)
+    ax.plot(*np.vstack([base, base[:1]]).T, color="gray", lw=0.8)
+    ax.quiver(*base.T, *S.T, length=0.3, normalize=True, color="C0")
+    ax.set_zlim(-0.5, 0.5)
+    if title:
+        ax.set_title(title)
+    return _finish(ax, path)
+
+
+def animate_spin_chain(Ss, path, *, times=None, fps: int = 10):
+    """An animated GIF of a spin chain evolving (frames Ss: (frames, N, 3)); matplotlib's Pillow
+    writer.  Returns `path`."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    plt = _pyplot()
+    fig = plt.figure(figsize=(4.0, 3.6))
+    ax = fig.add_subplot(projection="3d")
+
+    def frame(i):
+        ax.clear()
+        spin_chain(Ss[i], ax, title=None if times is None else f"t = {float(times[i]):.2f}")
+
+    FuncAnimation(fig, frame, frames=len(Ss)).save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path

@@ -106,6 +106,14 @@ def test_gradient_flow_keeps_fixed_entries():
     assert v[0] == 0.0 and np.allclose(v[1:], [-4.0, -6.0])
 
 
+def test_integrate_reports_divergence_instead_of_nan():
+    """ẏ = −1000 y with h = 0.1: the stage fixed-point iteration diverges; say so, name the step."""
+    from ddgjax.errors import ConvergenceError
+
+    with pytest.raises(ConvergenceError, match="non-finite at saved step 1"):
+        dg.integrate(lambda y: -1000.0 * y, jnp.ones(2), 1.0, steps=10)
+
+
 def test_integrate_bad_input():
     with pytest.raises(NonFiniteError, match=r"index \(1,\)"):
         dg.integrate(lambda x: x, np.array([0.0, np.nan]), 1.0)
