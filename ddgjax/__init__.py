@@ -11,6 +11,9 @@ import jax as _jax
 _jax.config.update("jax_enable_x64", True)
 
 from . import curves as curves  # noqa: E402
+from . import frames as frames  # noqa: E402
+from . import quaternion as quaternion  # noqa: E402
+from . import top as top  # noqa: E402
 from . import errors as errors  # noqa: E402
 from . import limits as limits  # noqa: E402
 from . import plot as plot  # noqa: E402
