@@ -16,7 +16,9 @@ from . import quaternion as quaternion  # noqa: E402
 from . import top as top  # noqa: E402
 from . import errors as errors  # noqa: E402
 from . import limits as limits  # noqa: E402
+from . import mesh as mesh  # noqa: E402
 from . import plot as plot  # noqa: E402
+from . import plot_surface as plot_surface  # noqa: E402
 from .flows import (  # noqa: E402
     gradient_flow as gradient_flow,
     hamiltonian_flow as hamiltonian_flow,

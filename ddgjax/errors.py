@@ -18,6 +18,10 @@ __all__ = [
     "ConvergenceError",
     "ArcLengthError",
     "SingularVertexError",
+    "MeshError",
+    "NonManifoldError",
+    "OrientationError",
+    "TriangleInequalityError",
 ]
 
 
@@ -72,4 +76,29 @@ class SingularVertexError(InvalidInputError):
     """A curve is singular at a vertex: successive points coincide (not regular, Def 1.2) or
     consecutive tangents are anti-parallel (turning angle π), where a formula divides by
     `1 + <T_k, T_{k-1}> = 0`.  The message names the vertex (or the coinciding vertices).
+    """
+
+
+class MeshError(InvalidInputError):
+    """A face list or cell decomposition is not a valid surface (Def 4.3); the message names the
+    offending vertex, edge or face index.
+    """
+
+
+class NonManifoldError(MeshError):
+    """An edge lies in more than two faces, or the faces around a vertex form more than one fan
+    (the vertex's neighbourhood is not a disk or half-disk).  The message names the edge's
+    vertices and faces, or the vertex.
+    """
+
+
+class OrientationError(MeshError):
+    """An operation needs a consistently oriented surface and the faces at an edge traverse it in
+    the same direction (or the surface is not orientable).  The message names the edge.
+    """
+
+
+class TriangleInequalityError(MeshError):
+    """Edge lengths violate a triangle inequality on some face (Sec 5.3); the message names the
+    face and its three lengths.
     """

@@ -197,3 +197,9 @@ def discrete_curvatures(Phi: Float[Array, "n 4"], h: float = 1.0) -> tuple[Array
     beta = qt._mul(qt._mul(qt._conj(Psi), b), Psi)
     K = 2 * beta[..., 1:] / (h * beta[..., :1])
     return K[..., 2], -K[..., 1], theta / h
+
+
+def twist_angle(Phi_prev: Float[Array, "4"], Phi_next: Float[Array, "4"]) -> Float[Array, ""]:
+    """The twist θ_k ∈ (−π, π] of one pair of edge frames (`edge_frame_split`), traceable and
+    without validation: the density of a rod's twisting energy."""
+    return _split(jnp.stack([Phi_prev, Phi_next]))[2][0]

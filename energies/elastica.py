@@ -142,6 +142,39 @@ def great_circle(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
     return (np.sin((1 - s)[:, None] * angle) * a + np.sin(s[:, None] * angle) * b) / np.sin(angle)
 
 
+def checked_chord(chord, length: float) -> np.ndarray:
+    """The chord as a (3,) array, or `InfeasibleChordError` if |chord| ≥ length (no bent
+    arc-length curve of that length has it)."""
+    if not (length > 0):
+        raise InvalidInputError(f"length must be positive, got {length}")
+    chord = np.array(chord, dtype=float)
+    if chord.shape != (3,) or not np.all(np.isfinite(chord)):
+        raise ShapeError(f"chord must be a finite vector of shape (3,), got {chord}")
+    if np.linalg.norm(chord) >= length:
+        raise InfeasibleChordError(
+            f"the chord |γ_n − γ_0| = {np.linalg.norm(chord):.6g} is not shorter than the length "
+            f"{length:.6g}: no bent arc-length curve has it (infeasible)"
+        )
+    return chord
+
+
+def starting_array(x0, default, shape: tuple) -> np.ndarray:
+    """`x0` (copied, shape-checked) or the `default()` start."""
+    X0 = default() if x0 is None else np.array(x0, dtype=float)
+    if X0.shape != shape:
+        raise ShapeError(f"x0 must have shape {shape}, got {X0.shape}")
+    return X0
+
+
+def clamp_ends(X0: np.ndarray, first, last) -> tuple[np.ndarray, np.ndarray]:
+    """X0 with its first and last rows set to the clamps, and the `fixed` mask of those rows."""
+    X0 = X0.copy()
+    X0[0], X0[-1] = first, last
+    fixed = np.zeros(X0.shape, bool)
+    fixed[[0, -1]] = True
+    return X0, fixed
+
+
 def initial_tangents(n: int, length: float, chord, t_start, t_end) -> np.ndarray:
     """A rough start: the great-circle interpolation of the end tangents, shifted by a constant
     vector and renormalised so that its mean matches chord/length (a few fixed-point steps)."""
@@ -179,28 +212,15 @@ def clamped(
         raise InvalidInputError(f"a clamped elastica needs at least 3 edges, got n = {n}")
     if clamp not in ("edge", "vertex"):
         raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
-    if not (length > 0):
-        raise InvalidInputError(f"length must be positive, got {length}")
-    chord = np.array(chord, dtype=float)
-    if chord.shape != (3,) or not np.all(np.isfinite(chord)):
-        raise ShapeError(f"chord must be a finite vector of shape (3,), got {chord}")
-    if np.linalg.norm(chord) >= length:
-        raise InfeasibleChordError(
-            f"the chord |γ_n − γ_0| = {np.linalg.norm(chord):.6g} is not shorter than the length "
-            f"{length:.6g}: no bent arc-length curve has it (infeasible)"
-        )
+    chord = checked_chord(chord, length)
     t_start, t_end = _unit_vector(t_start, "t_start"), _unit_vector(t_end, "t_end")
     n, h = int(n), float(length) / int(n)
-    T0 = initial_tangents(n, length, chord, t_start, t_end) if x0 is None else np.array(x0, dtype=float)
-    if T0.shape != (n, 3):
-        raise ShapeError(f"x0 must have shape ({n}, 3), got {T0.shape}")
+    T0 = starting_array(x0, lambda: initial_tangents(n, length, chord, t_start, t_end), (n, 3))
     edges = np.arange(n)
     energy = dg.local_sum(_bend, np.stack([edges[:-1], edges[1:]], axis=1))
     fixed = np.zeros((n, 3), bool)
     if clamp == "edge":
-        T0 = T0.copy()
-        T0[0], T0[-1] = t_start, t_end
-        fixed[[0, -1]] = True
+        T0, fixed = clamp_ends(T0, t_start, t_end)
         free_edges = edges[1:-1]
     else:
         energy = energy + dg.local_sum(_ghost_bend, np.array([[0], [n - 1]]), data=np.array([0, 1]))
@@ -221,9 +241,7 @@ def closed(n: int, *, length: float = 1.0, x0) -> dg.Problem:
     energy summed over all n vertices.  Critical points include the regular n-gon (the minimum)
     and Euler's figure-eight (a saddle).  Rotations act freely: the KKT matrix is singular."""
     n, h = int(n), float(length) / int(n)
-    T0 = np.array(x0, dtype=float)
-    if T0.shape != (n, 3):
-        raise ShapeError(f"x0 must have shape ({n}, 3), got {T0.shape}")
+    T0 = starting_array(x0, lambda: None, (n, 3))
     edges = np.arange(n)
     energy = dg.local_sum(_bend, np.stack([np.roll(edges, 1), edges], axis=1))
     constraints = dg.concat(

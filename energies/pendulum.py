@@ -23,10 +23,10 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
-from ddgjax.errors import InvalidInputError, ShapeError
+from ddgjax.errors import InvalidInputError
 from solvers import solve
 
-from .elastica import bending_density, great_circle
+from .elastica import bending_density, clamp_ends, great_circle, starting_array
 
 __all__ = ["action", "step", "shoot", "kinetic"]
 
@@ -65,15 +65,7 @@ def action(n: int, *, a, T_first, T_last, x0=None) -> dg.Problem:
         raise InvalidInputError(f"the pendulum needs at least 3 tangents, got n = {n}")
     n = int(n)
     first, last = _unit_vector(T_first, "T_first"), _unit_vector(T_last, "T_last")
-    if x0 is None:
-        T0 = great_circle(first, last, np.linspace(0.0, 1.0, n))
-    else:
-        T0 = np.array(x0, dtype=float)
-        if T0.shape != (n, 3):
-            raise ShapeError(f"x0 must have shape ({n}, 3), got {T0.shape}")
-    T0[0], T0[-1] = first, last
-    fixed = np.zeros((n, 3), bool)
-    fixed[[0, -1]] = True
+    T0, fixed = clamp_ends(starting_array(x0, lambda: great_circle(first, last, np.linspace(0.0, 1.0, n)), (n, 3)), first, last)
     k = np.arange(n)
     energy = dg.local_sum(_kinetic_term, np.stack([k[:-1], k[1:]], axis=1)) + dg.local_sum(_potential_term, k[:, None])
     return dg.Problem(

@@ -118,11 +118,15 @@ class SparseAlgebra:
             if pattern.split(augmented) is None:
                 pattern.symbolic(augmented)
 
+    # Equal by the problem structure the pattern was built from (functions, stencils, layout),
+    # so that every problem declared alike (e.g. each `elastica.clamped(n, ...)` call) reuses
+    # one compiled solver.  jit's cache keeps the first algebra, and with it the KLU analyses
+    # its compiled code refers to, alive.
     def __hash__(self):
-        return id(self.pattern)
+        return hash(self.pattern.key)
 
     def __eq__(self, other):
-        return isinstance(other, SparseAlgebra) and other.pattern is self.pattern
+        return isinstance(other, SparseAlgebra) and other.pattern.key == self.pattern.key
 
     def _values(self, kkt: KKT, w, mu_rel, identity_hessian):
         """Coalesced COO values of `K + μS` (K's Hessian block replaced by I if asked)."""

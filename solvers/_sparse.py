@@ -40,6 +40,7 @@ class SparsePattern:
     source: np.ndarray  # (n_raw,) int32: index into the raw block values
     target: np.ndarray  # (n_raw + n + m,) int32: coalesced entry of each raw value and diagonal
     coupled: np.ndarray  # KKT indices of the multipliers of global sums (e.g. a chord)
+    key: tuple = ()  # the Spec key it was built from: equal keys give interchangeable patterns
 
     @property
     def nnz(self) -> int:
@@ -236,6 +237,7 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
         source=np.concatenate(src_list).astype(np.int32),
         target=target.astype(np.int32),
         coupled=np.unique([n + r for tp in constraint_terms if tp.term.reduce == "sum" for r in tp.rows[0]]).astype(np.int64),
+        key=spec.key(),
     )
 
 

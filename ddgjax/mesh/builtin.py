@@ -1,0 +1,222 @@
+"""Built-in polyhedral surfaces: each function returns `(V, F)`, V (nv, 3) float64, F int64.
+
+Closed orientable ones are oriented with outward normals (faces counter-clockwise seen from
+outside).  Non-orientable ones are immersed or, for the projective plane, only combinatorially
+meaningful (its six vertices are representatives of antipodal icosahedron vertices; the
+straight triangles between them intersect, which does not affect angle sums).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InvalidInputError
+
+__all__ = [
+    "tetrahedron",
+    "cube",
+    "octahedron",
+    "icosahedron",
+    "icosphere",
+    "torus",
+    "projective_plane",
+    "klein_bottle",
+    "double_torus",
+    "disk",
+    "annulus",
+    "mobius_strip",
+    "grid_quads",
+    "triangulate",
+]
+
+
+def _mesh(V, F):
+    return np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64)
+
+
+def tetrahedron():
+    """The regular tetrahedron inscribed in the cube [-1, 1]³ (4 vertices, 4 faces)."""
+    V = [[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]]
+    F = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]
+    return _mesh(V, F)
+
+
+def triangulate(F) -> np.ndarray:
+    """Split each convex k-gon of an (nf, k) array into k − 2 triangles by a fan from its first
+    corner, keeping the orientation.
+    """
+    F = np.asarray(F)
+    k = F.shape[1]
+    fans = [F[:, [0, i, i + 1]] for i in range(1, k - 1)]
+    return np.stack(fans, axis=1).reshape(-1, 3)
+
+
+def cube(triangulated: bool = False):
+    """The unit cube [0, 1]³: 6 squares (Example 5.1), or 12 triangles when `triangulated`."""
+    V = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+    F = np.array([[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]])
+    return _mesh(V, triangulate(F) if triangulated else F)
+
+
+def octahedron():
+    """The regular octahedron with vertices ±e_i."""
+    V = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
+    F = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    return _mesh(V, F)
+
+
+def icosahedron():
+    """The regular icosahedron on the unit sphere; vertex i + 6 is the antipode of vertex i."""
+    t = (1 + 5**0.5) / 2
+    half = np.array([[-1, t, 0], [1, t, 0], [0, 1, t], [0, 1, -t], [t, 0, 1], [-t, 0, 1]], dtype=float)
+    V = np.vstack([half, -half]) / np.sqrt(1 + t * t)
+    F = _hull_faces(V)
+    return _mesh(V, F)
+
+
+def _hull_faces(V) -> np.ndarray:
+    """Faces of the convex hull of points in convex position, oriented outward."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(V)
+    F = hull.simplices.copy()
+    normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    flip = np.einsum("ij,ij->i", normals, hull.equations[:, :3]) < 0
+    F[flip] = F[flip][:, ::-1]
+    return F
+
+
+def _subdivide(V, F):
+    """Split each triangle into four at its edge midpoints (vectorised with unique edges)."""
+    nv = V.shape[0]
+    he = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
+    edges, mid = np.unique(np.sort(he, axis=1), axis=0, return_inverse=True)
+    mid = mid.reshape(-1, 3) + nv
+    V = np.vstack([V, 0.5 * (V[edges[:, 0]] + V[edges[:, 1]])])
+    a, b, c = F.T
+    ab, bc, ca = mid.T
+    F = np.concatenate([np.stack(t, axis=1) for t in ([a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca])])
+    return V, F
+
+
+def icosphere(level: int = 1):
+    """The icosahedron subdivided `level` times (20·4^level faces), projected to the unit sphere."""
+    V, F = icosahedron()
+    for _ in range(level):
+        V, F = _subdivide(V, F)
+        V = V / np.linalg.norm(V, axis=1, keepdims=True)
+    return _mesh(V, F)
+
+
+def grid_quads(m: int, n: int, wrap_u: bool, wrap_v: bool, twist: bool = False) -> np.ndarray:
+    """Quads (i, j), (i+1, j), (i+1, j+1), (i, j+1) of an m × n vertex grid, vertex i·n + j.
+
+    `wrap_u` glues row m to row 0; with `twist` it glues (m, j) to (0, n − 1 − j) (Möbius strip,
+    Klein bottle).  `wrap_v` glues column n to column 0.
+    """
+    i, j = np.meshgrid(np.arange(m if wrap_u else m - 1), np.arange(n if wrap_v else n - 1), indexing="ij")
+    i, j = i.reshape(-1), j.reshape(-1)
+
+    def index(a, b):
+        b = b % n
+        wrapped = a >= m
+        b = np.where(wrapped & twist, n - 1 - b, b)
+        return (a % m) * n + b
+
+    return np.stack([index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)], axis=1)
+
+
+def _check_grid(**sizes):
+    for name, (value, least) in sizes.items():
+        if value < least:
+            raise InvalidInputError(f"{name} must be at least {least}, got {value}")
+
+
+def torus(m: int = 16, n: int = 8, R: float = 1.0, r: float = 0.4):
+    """Torus of revolution, m × n vertices, triangulated, outward oriented (genus 1)."""
+    _check_grid(m=(m, 3), n=(n, 3))
+    u, v = np.meshgrid(2 * np.pi * np.arange(m) / m, 2 * np.pi * np.arange(n) / n, indexing="ij")
+    V = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], -1)
+    return _mesh(V.reshape(-1, 3), triangulate(grid_quads(m, n, True, True)))
+
+
+def projective_plane():
+    """The hemi-icosahedron: the icosahedron modulo the antipodal map (6 vertices, 15 edges,
+    10 faces, χ = 1), a triangulation of RP²; V holds one representative per antipodal pair.
+    """
+    V, F = icosahedron()
+    F6 = F % 6
+    key = np.sort(F6, axis=1)
+    _, first = np.unique(key, axis=0, return_index=True)
+    return _mesh(V[:6], F6[np.sort(first)])
+
+
+def klein_bottle(m: int = 24, n: int = 12, R: float = 2.0):
+    """The figure-8 immersion of the Klein bottle, m × n vertices (n even), triangulated.
+
+    (u, v) ~ (u + 2π, −v); vertex columns sit at v_j = 2π (j + ½)/n so that the identification
+    maps column j to n − 1 − j and no two vertices coincide on the self-intersection circle.
+    """
+    _check_grid(m=(m, 3), n=(n, 4))
+    u, v = np.meshgrid(2 * np.pi * np.arange(m) / m, 2 * np.pi * (np.arange(n) + 0.5) / n, indexing="ij")
+    w = np.cos(u / 2) * np.sin(v) - np.sin(u / 2) * np.sin(2 * v)
+    V = np.stack([(R + w) * np.cos(u), (R + w) * np.sin(u),
+                  np.sin(u / 2) * np.sin(v) + np.cos(u / 2) * np.sin(2 * v)], -1)
+    return _mesh(V.reshape(-1, 3), triangulate(grid_quads(m, n, True, True, twist=True)))
+
+
+def _voxel_boundary(occupied: np.ndarray):
+    """Outward-oriented boundary squares of a union of unit voxels, triangulated."""
+    padded = np.pad(occupied, 1)
+    quads = []
+    corners = {  # square of the face in direction ±axis, counter-clockwise seen from outside
+        (0, 1): [(1, 0, 0), (1, 1, 0), (1, 1, 1), (1, 0, 1)], (0, -1): [(0, 0, 0), (0, 0, 1), (0, 1, 1), (0, 1, 0)],
+        (1, 1): [(0, 1, 0), (0, 1, 1), (1, 1, 1), (1, 1, 0)], (1, -1): [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)],
+        (2, 1): [(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)], (2, -1): [(0, 0, 0), (0, 1, 0), (1, 1, 0), (1, 0, 0)],
+    }
+    cells = np.argwhere(padded)
+    for (axis, step), square in corners.items():
+        shift = np.zeros(3, dtype=int)
+        shift[axis] = step
+        nb = cells + shift
+        open_side = ~padded[nb[:, 0], nb[:, 1], nb[:, 2]]
+        quads.append(cells[open_side][:, None, :] + np.array(square)[None])
+    points = np.concatenate(quads).reshape(-1, 3)
+    V, F = np.unique(points, axis=0, return_inverse=True)
+    return _mesh(V - 1.0, triangulate(F.reshape(-1, 4)))
+
+
+def double_torus():
+    """A genus-2 polycube: the boundary of a 3 × 5 × 1 slab of unit cubes with two cubes
+    removed, triangulated (χ = −2).
+    """
+    occupied = np.ones((3, 5, 1), dtype=bool)
+    occupied[1, 1, 0] = occupied[1, 3, 0] = False
+    return _voxel_boundary(occupied)
+
+
+def disk(rings: int = 4, m: int = 12):
+    """The unit disk: a centre vertex and `rings` concentric rings of m vertices, triangulated."""
+    _check_grid(rings=(rings, 1), m=(m, 3))
+    t, r = np.meshgrid(2 * np.pi * np.arange(m) / m, np.arange(1, rings + 1) / rings, indexing="ij")
+    V = np.vstack([[0.0, 0.0, 0.0], np.stack([r * np.cos(t), r * np.sin(t), 0 * r], -1).reshape(-1, 3)])
+    first_ring = 1 + np.arange(m) * rings
+    fan = np.stack([np.zeros(m, dtype=int), first_ring, np.roll(first_ring, -1)], 1)
+    rings_ = 1 + grid_quads(m, rings, True, False)[:, ::-1]
+    return _mesh(V, np.vstack([fan, triangulate(rings_)]))
+
+
+def annulus(m: int = 16, n: int = 3, r_in: float = 0.5, r_out: float = 1.0):
+    """The planar annulus r_in ≤ |x| ≤ r_out, m × n vertices, triangulated (two boundary loops)."""
+    _check_grid(m=(m, 3), n=(n, 2))
+    t, r = np.meshgrid(2 * np.pi * np.arange(m) / m, np.linspace(r_in, r_out, n), indexing="ij")
+    V = np.stack([r * np.cos(t), r * np.sin(t), 0 * r], -1).reshape(-1, 3)
+    return _mesh(V, triangulate(grid_quads(m, n, True, False)[:, ::-1]))
+
+
+def mobius_strip(m: int = 24, n: int = 4, width: float = 0.6):
+    """A Möbius strip of centre radius 1: m × n vertices, (m, j) glued to (0, n − 1 − j)."""
+    _check_grid(m=(m, 3), n=(n, 2))
+    u, w = np.meshgrid(2 * np.pi * np.arange(m) / m, np.linspace(-width / 2, width / 2, n), indexing="ij")
+    V = np.stack([(1 + w * np.cos(u / 2)) * np.cos(u), (1 + w * np.cos(u / 2)) * np.sin(u), w * np.sin(u / 2)], -1)
+    return _mesh(V.reshape(-1, 3), triangulate(grid_quads(m, n, True, False, twist=True)))

@@ -1,0 +1,244 @@
+"""Curvature of polyhedral surfaces (Sec 5.2): angle defects and edge mean curvature, in jnp.
+
+`V` is (nv, 3) float; `F` an (nf, k) int array (numpy or jnp) or a list of convex planar polygons.
+The geometry is jnp and differentiable in `V`; for an (nf, k) array everything is jnp, so
+`jax.jit(angle_defect)(V, F)` works with a traced `F`, and functions of `V` alone
+(`jax.jit(lambda V: edge_mean_curvature(V, F))`) close over a concrete `F` whose connectivity is
+built (and validated) once, at trace time.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._checks import is_concrete
+from ..errors import MeshError, OrientationError, ShapeError
+from .connectivity import Halfedges, faces_as_corners, from_faces
+
+__all__ = [
+    "corner_angles",
+    "angle_defect",
+    "vertex_kind",
+    "face_area_vectors",
+    "surface_area",
+    "dihedral_angles",
+    "edge_mean_curvature",
+    "total_mean_curvature",
+    "steiner_area",
+]
+
+
+def _corners(F):
+    """`(vertex, next, prev)` per corner; jnp-traceable for an (nf, k) array."""
+    if hasattr(F, "shape") and len(F.shape) == 2:
+        nf, k = F.shape
+        index = np.arange(nf * k).reshape(nf, k)
+        return jnp.reshape(jnp.asarray(F), -1), np.roll(index, -1, 1).reshape(-1), np.roll(index, 1, 1).reshape(-1)
+    vertex, _, nxt = faces_as_corners(F)
+    prv = np.empty_like(nxt)
+    prv[nxt] = np.arange(nxt.size)
+    return jnp.asarray(vertex), nxt, prv
+
+
+def _validate(V, F):
+    """Shape checks, and for a concrete `F` its connectivity (manifold, indices, no unused
+    vertex), returned as `Halfedges`; None for a traced `F`.
+    """
+    if len(jnp.shape(V)) != 2 or jnp.shape(V)[1] != 3:
+        raise ShapeError(f"V must have shape (nv, 3), got {jnp.shape(V)}")
+    if not is_concrete(F):
+        return None
+    nv = jnp.shape(V)[0]
+    h = from_faces(F if not hasattr(F, "shape") else np.asarray(F), n_vertices=nv)
+    unused = np.flatnonzero(np.bincount(h.vertex, minlength=nv) == 0)
+    if unused.size:
+        raise MeshError(f"vertex {unused[0]} lies in no face; remove unused vertices first")
+    return h
+
+
+def boundary_vertex_mask(h) -> np.ndarray:
+    """Bool (n_vertices,): the vertex lies on a boundary edge (numpy, from `Halfedges`)."""
+    mask = np.zeros(h.n_vertices, dtype=bool)
+    lonely = h.twin < 0
+    mask[h.vertex[lonely]] = True
+    mask[h.head[lonely]] = True
+    return mask
+
+
+def _angle_between(u, w):
+    """Unsigned angle in [0, π] between rows of u and w: atan2(|u × w|, u · w) (accurate near 0, π)."""
+    return jnp.arctan2(jnp.linalg.norm(jnp.cross(u, w), axis=-1), jnp.sum(u * w, axis=-1))
+
+
+@jax.jit
+def _angles_at_corners(V, vertex, nxt, prv):
+    P = V[vertex]
+    return _angle_between(P[nxt] - P, P[prv] - P)
+
+
+def corner_angles(V, F):
+    """Interior angle α at every corner of every (convex) face: α = ∠(v_next − v, v_prev − v).
+
+    **Returns:** (nf, k) for an (nf, k) array `F`, else (n_corners,) in the order of the faces.
+    **Raises:** as `angle_defect`.
+    """
+    _validate(V, F)
+    angles = _angles_at_corners(jnp.asarray(V), *_corners(F))
+    return angles.reshape(jnp.shape(F)) if hasattr(F, "shape") else angles
+
+
+def _boundary_vertices(vertex, nxt, nv):
+    """Bool (nv,): the vertex is on a boundary edge (an edge with a single halfedge); jnp, for a
+    traced F (with a concrete F, `boundary_vertex_mask` avoids sorting constants under jit).
+    """
+    head = vertex[nxt]
+    key = jnp.minimum(vertex, head) * nv + jnp.maximum(vertex, head)
+    ordered = jnp.sort(key)
+    count = jnp.searchsorted(ordered, key, side="right") - jnp.searchsorted(ordered, key, side="left")
+    lonely = (count == 1).astype(jnp.int32)
+    return jnp.maximum(jax.ops.segment_max(lonely, vertex, nv), jax.ops.segment_max(lonely, head, nv)) > 0
+
+
+@jax.jit
+def defect_from_angles(angles, vertex, boundary):
+    """K(p) = 2π − Σ α at interior vertices (Def 5.2), φ(p) = π − Σ α at boundary vertices
+    (Remark 5.4), from the flat corner angles, their vertices and the (nv,) boundary mask.
+    """
+    total = jax.ops.segment_sum(angles, vertex, boundary.shape[0])
+    return jnp.where(boundary, jnp.pi, 2 * jnp.pi) - total
+
+
+def angle_defect(V, F):
+    """Discrete Gaussian curvature per vertex, (nv,) (Def 5.2, Remark 5.4):
+
+        K(p) = 2π − Σ_i α_i  at an interior vertex,   φ(p) = π − Σ_i α_i  at a boundary vertex,
+
+    so that Σ_p = 2πχ for every (possibly bounded, possibly non-orientable) surface (Thm 5.6).
+
+    **Raises:** `ShapeError` for V not (nv, 3); for concrete `F`, `MeshError` /
+    `NonManifoldError` for bad faces (see `connectivity.from_faces`) and for a vertex in no face.
+    """
+    h = _validate(V, F)
+    vertex, nxt, prv = _corners(F)
+    nv = jnp.shape(V)[0]
+    boundary = _boundary_vertices(vertex, nxt, nv) if h is None else boundary_vertex_mask(h)
+    return _angle_defect_kernel(jnp.asarray(V), vertex, nxt, prv, boundary)
+
+
+@jax.jit
+def _angle_defect_kernel(V, vertex, nxt, prv, boundary):
+    return defect_from_angles(_angles_at_corners(V, vertex, nxt, prv), vertex, boundary)
+
+
+def vertex_kind(V, F, atol: float = 1e-12):
+    """+1 elliptic (K > atol), 0 flat (|K| ≤ atol), −1 hyperbolic (K < −atol) per vertex (Def 5.2);
+    boundary vertices are classified by their turning angle.
+    """
+    K = angle_defect(V, F)
+    return jnp.where(K > atol, 1, jnp.where(K < -atol, -1, 0))
+
+
+def face_area_vectors(V, F):
+    """(nf, 3): ½ Σ_i v_i × v_{i+1} over each face (Newell); its norm is the area of a planar
+    face and its direction the normal given by the face's orientation.
+    """
+    vertex, nxt, _ = _corners(F)
+    face = np.repeat(np.arange(jnp.shape(F)[0]), jnp.shape(F)[1]) if hasattr(F, "shape") else faces_as_corners(F)[1]
+    n_faces = int(face.max()) + 1 if face.size else 0
+    return _area_vectors(jnp.asarray(V), vertex, nxt, face, n_faces)
+
+
+@partial(jax.jit, static_argnums=4)
+def _area_vectors(V, vertex, nxt, face, n_faces):
+    P = V[vertex]
+    return 0.5 * jax.ops.segment_sum(jnp.cross(P, P[nxt]), face, n_faces)
+
+
+def surface_area(V, F):
+    """A(S) = Σ_f |face area vector| (planar faces)."""
+    return jnp.sum(jnp.linalg.norm(face_area_vectors(V, F), axis=-1))
+
+
+def _interior_pairs(F, nv):
+    """For each edge: a halfedge h1 on it, its twin h2 (−1 on the boundary), and their faces;
+    raises `OrientationError` where both faces run through an edge in the same direction.
+    `F` may already be `Halfedges`.
+    """
+    h = F if isinstance(F, Halfedges) else from_faces(np.asarray(F) if hasattr(F, "shape") else F, n_vertices=nv)
+    order = np.argsort(h.edge, kind="stable")
+    first = order[np.concatenate([[0], np.flatnonzero(np.diff(h.edge[order])) + 1])]
+    h2 = h.twin[first]
+    inner = h2 >= 0
+    same = inner & (h.sign[first] == h.sign[np.where(inner, h2, first)])
+    if np.any(same):
+        e = int(np.argmax(same))
+        raise OrientationError(
+            f"edge {e} ({h.edges[e, 0]}, {h.edges[e, 1]}) is traversed in the same direction by faces "
+            f"{h.face[first[e]]} and {h.face[h2[e]]}; the signed dihedral angle needs a consistent "
+            "orientation (mesh.orient(F), if the surface is orientable)"
+        )
+    return h, first, h2
+
+
+def dihedral_angles(V, F):
+    """Signed exterior dihedral angle θ(e) ∈ (−π, π] per edge, ordered like `edges(F)` (Def 5.3).
+
+    With N₁, N₂ the unit normals of the faces left and right of e (N from the face orientation)
+    and d the unit direction of e as traversed by the first face,
+
+        θ(e) = atan2(⟨d, N₁ × N₂⟩, ⟨N₁, N₂⟩),
+
+    the angle turning N₁ into N₂.  It is positive at convex edges of an outward-oriented surface
+    (θ = π/2 on the cube) and negative at concave ones; θ = 0 on boundary edges.
+
+    **Raises:** `OrientationError` if two faces traverse an edge in the same direction.
+    """
+    return _dihedral_angles_and_edges(V, F)[0]
+
+
+def _dihedral_angles_and_edges(V, F):
+    checked = _validate(V, F)
+    h, h1, h2 = _interior_pairs(F if checked is None else checked, jnp.shape(V)[0])
+    inner = h2 >= 0
+    f1, f2 = h.face[h1], h.face[np.where(inner, h2, h1)]
+    theta = _signed_dihedral(face_area_vectors(V, F), jnp.asarray(V), h.vertex[h1], h.head[h1], f1, f2)
+    return jnp.where(jnp.asarray(inner), theta, 0.0), h.edges
+
+
+@jax.jit
+def _signed_dihedral(N, V, tail, head, f1, f2):
+    N = N / jnp.linalg.norm(N, axis=-1, keepdims=True)
+    d = V[head] - V[tail]
+    d = d / jnp.linalg.norm(d, axis=-1, keepdims=True)
+    N1, N2 = N[f1], N[f2]
+    return jnp.arctan2(jnp.sum(d * jnp.cross(N1, N2), axis=-1), jnp.sum(N1 * N2, axis=-1))
+
+
+def edge_mean_curvature(V, F):
+    """H(e) = ½ θ(e) l(e) per edge, ordered like `edges(F)` (Def 5.3); θ as in `dihedral_angles`
+    (positive at convex edges of an outward-oriented surface, 0 on the boundary).
+    """
+    theta, E = _dihedral_angles_and_edges(V, F)
+    return _half_angle_times_length(theta, jnp.asarray(V), E)
+
+
+@jax.jit
+def _half_angle_times_length(theta, V, E):
+    return 0.5 * theta * jnp.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=-1)
+
+
+def total_mean_curvature(V, F):
+    """H(S) = Σ_e H(e) = ½ Σ_e θ(e) l(e) (Def 5.3)."""
+    return jnp.sum(edge_mean_curvature(V, F))
+
+
+def steiner_area(V, F, rho):
+    """A(S_ρ) = A(S) + 2 H(S) ρ + K(S) ρ², K(S) = Σ_p K(p) = 2πχ (Thm 5.7 for convex polyhedra,
+    where K(S) = 4π; Remark 5.5 for closed polyhedral surfaces with signed pieces).
+    """
+    K = jnp.sum(angle_defect(V, F))
+    return surface_area(V, F) + 2 * total_mean_curvature(V, F) * rho + K * rho**2

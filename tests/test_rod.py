@@ -1,0 +1,47 @@
+"""Discrete isotropic elastic rods (Def 3.6, 3.7): quaternion edge frames, bending + twist."""
+
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from ddgjax import quaternion as qt
+from ddgjax.errors import InvalidInputError
+from energies import elastica, rod
+from solvers import solve
+
+E2, E3 = jnp.array([0.0, 1.0, 0.0]), jnp.array([0.0, 0.0, 1.0])
+START = qt.from_axis_angle(E3, np.pi / 2)  # tangent e1 -> e2
+END = qt.from_axis_angle(E3, -np.pi / 2)  # tangent e1 -> -e2
+
+
+def test_untwisted_planar_rod_is_the_elastica():
+    """With end frames that differ by no twist, the rod's centreline is the discrete elastica."""
+    n = 40
+    sol = solve(rod.clamped(n, alpha=0.7, chord=[0.6, 0, 0], frame_start=START, frame_end=END))
+    assert float(sol.residual) <= 1e-10
+    assert float(jnp.max(jnp.abs(rod.twist_angles(sol.x)))) <= 1e-12
+    curve = solve(elastica.clamped(n, chord=[0.6, 0, 0], t_start=[0, 1, 0], t_end=[0, -1, 0]))
+    assert float(jnp.max(jnp.abs(rod.tangents(sol.x) - curve.x))) <= 1e-10
+
+
+@pytest.mark.parametrize("twist", [1.0, 2.5])
+def test_twisted_rod_has_constant_twist(twist):
+    """Discrete analogue of Lemma 3.12 (τ' = 0): all twist angles θ_k equal at a critical rod,
+    and the twisted rod leaves the plane of its untwisted elastica."""
+    n = 40
+    end = qt.mul(qt.from_axis_angle(-E2, twist), END)  # twist the end frame about its tangent −e2
+    sol = solve(rod.clamped(n, alpha=0.7, chord=[0.6, 0, 0], frame_start=START, frame_end=end))
+    assert float(sol.residual) <= 1e-10
+    theta = np.asarray(rod.twist_angles(sol.x))
+    assert np.max(np.abs(theta - theta[0])) <= 1e-10
+    assert abs(theta[0]) > 1e-3
+    assert float(jnp.max(jnp.abs(rod.tangents(sol.x)[:, 2]))) > 1e-3  # non-planar centreline
+
+
+def test_bad_input():
+    with pytest.raises(InvalidInputError, match="alpha"):
+        rod.clamped(10, alpha=-1.0, chord=[0.6, 0, 0], frame_start=START, frame_end=END)
+    with pytest.raises(elastica.InfeasibleChordError):
+        rod.clamped(10, alpha=1.0, chord=[1.5, 0, 0], frame_start=START, frame_end=END)
+    with pytest.raises(InvalidInputError):
+        rod.clamped(10, alpha=1.0, chord=[0.6, 0, 0], frame_start=2 * START, frame_end=END)
