@@ -61,13 +61,16 @@ def clamped(n: int, *, alpha: float, length: float = 1.0, chord, frame_start, fr
     `frame_start`, `frame_end`: unit quaternions [4] of the clamped end edges (their tangents are
     `rotate(frame, e1)`).
 
-    **Raises:** `InfeasibleChordError` (|chord| ≥ length), `InvalidInputError` (α < 0, n < 3,
+    **Raises:** `InfeasibleChordError` (|chord| ≥ length), `InvalidInputError` (α ≤ 0, n < 3,
     non-unit frames), `ShapeError`.
     """
     if int(n) < 3:
         raise InvalidInputError(f"a clamped rod needs at least 3 edges, got n = {n}")
-    if not (alpha >= 0):
-        raise InvalidInputError(f"the twist stiffness alpha must be >= 0, got {alpha}")
+    if not (np.isfinite(alpha) and alpha > 0):
+        raise InvalidInputError(
+            f"the twist stiffness alpha must be positive (the reference requires α ≠ 0; α = 0 leaves "
+            f"the frames' twist undetermined), got {alpha}"
+        )
     chord = checked_chord(chord, length)
     qt.check_unit(frame_start, "frame_start")
     qt.check_unit(frame_end, "frame_end")

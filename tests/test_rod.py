@@ -39,8 +39,9 @@ def test_twisted_rod_has_constant_twist(twist):
 
 
 def test_bad_input():
-    with pytest.raises(InvalidInputError, match="alpha"):
-        rod.clamped(10, alpha=-1.0, chord=[0.6, 0, 0], frame_start=START, frame_end=END)
+    for alpha in (-1.0, 0.0):
+        with pytest.raises(InvalidInputError, match="alpha"):
+            rod.clamped(10, alpha=alpha, chord=[0.6, 0, 0], frame_start=START, frame_end=END)
     with pytest.raises(elastica.InfeasibleChordError):
         rod.clamped(10, alpha=1.0, chord=[1.5, 0, 0], frame_start=START, frame_end=END)
     with pytest.raises(InvalidInputError):
