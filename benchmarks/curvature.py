@@ -13,17 +13,22 @@ are printed as a check.
 
     python benchmarks/curvature.py [--levels 5 6 8] [--repeats 5]
 
-Measured 2026-11-21 on a 2-core CPU shared with other jobs (load ≈ 4), libigl 2.x from pip;
-"compile" includes building and validating the halfedge connectivity at trace time:
+Measured 2026-11-21 on an otherwise idle 2-core CPU (load ≈ 1), libigl 2.x from pip, medians of 5
+after warm-up; "compile" includes building and validating the halfedge connectivity at trace
+time:
 
 | faces | quantity | ddgjax compile (s) | ddgjax median (ms) | libigl median (ms) | igl/ddgjax | max diff |
 |---|---|---|---|---|---|---|
-| 20480 | angle defect | 0.64 | 9.54 | 7.07 | 0.74 | 1.8e-15 |
-| 20480 | edge mean curvature | 0.63 | 7.16 | 38.70 | 5.40 | 1.8e-15 |
-| 81920 | angle defect | 1.62 | 28.08 | 24.86 | 0.89 | 1.6e-15 |
-| 81920 | edge mean curvature | 1.72 | 13.87 | 305.61 | 22.03 | 4.8e-15 |
-| 1310720 | angle defect | 31.50 | 1747.93 | 997.79 | 0.57 | 1.8e-15 |
-| 1310720 | edge mean curvature | 35.36 | 689.41 | 13668.55 | 19.83 | 2.1e-14 |
+| 20480 | angle defect | 0.30 | 5.06 | 2.77 | 0.55 | 1.8e-15 |
+| 20480 | edge mean curvature | 0.31 | 4.24 | 15.22 | 3.59 | 1.8e-15 |
+| 81920 | angle defect | 0.66 | 10.57 | 17.50 | 1.66 | 1.6e-15 |
+| 81920 | edge mean curvature | 0.67 | 8.49 | 101.27 | 11.92 | 4.8e-15 |
+| 1310720 | angle defect | 10.85 | 344.36 | 361.28 | 1.05 | 1.8e-15 |
+| 1310720 | edge mean curvature | 12.36 | 347.05 | 2562.17 | 7.38 | 2.1e-14 |
+
+A second idle run at 1.3×10⁶ faces gave 327 ms against 450 ms for the angle defect; on a
+machine loaded by other jobs (load ≈ 4) the angle defect was 0.57× libigl's speed, so the margin
+at 10⁶ faces is thin.  At 2×10⁴ faces libigl's angle defect is faster (fixed overheads).
 
 libigl's edge number includes its `edge_topology` (ours is built once, at trace time), so that
 column compares a full recomputation with a cached one; the angle defect is like for like.
