@@ -15,7 +15,6 @@ from typing import Callable
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from ddgjax._flat import Layout, layout_of
 from ddgjax.locality import Local

@@ -7,7 +7,6 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from ddgjax._checks import is_concrete
 from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError

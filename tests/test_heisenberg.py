@@ -91,7 +91,6 @@ def test_scaled_hamiltonian_converges_to_dirichlet_energy(kind):
     """(H − H_aligned)/ε → (J/2)∫|S'|² dx for a smooth periodic spin field."""
     J = 1.5
     fine = 4096
-    x = 2 * np.pi * np.arange(fine) / fine
     S = np.asarray(smooth_spins(fine))
     dS = (np.roll(S, -1, 0) - np.roll(S, 1, 0)) / (2 * (2 * np.pi / fine))  # spectral-accurate enough
     exact = 0.5 * J * np.sum(dS**2) * (2 * np.pi / fine)
