@@ -42,6 +42,7 @@ __all__ = [
     "edge_vectors",
     "edge_lengths",
     "tangents",
+    "tangent_velocity",
     "turning_angles",
     "curvature",
     "vertex_tangent",
@@ -390,8 +391,9 @@ def local_bending_energy(T_prev: Float[Array, " d"], T_next: Float[Array, " d"])
 _bending_gradients = jax.vmap(jax.grad(local_bending_energy, argnums=(0, 1)))
 
 
-def _tangent_velocity(T_prev: Array, T_next: Array) -> Array:
-    """`−(∇_{T_{k−1}} + ∇_{T_k}) E_k = (T_k + T_{k−1}) / (1 + <T_k, T_{k−1}>)`."""
+def tangent_velocity(T_prev: Array, T_next: Array) -> Array:
+    """`−(∇_{T_{k−1}} + ∇_{T_k}) E_k = (T_k + T_{k−1}) / (1 + <T_k, T_{k−1}>)` (Prop 2.1), by autodiff,
+    for stacked tangent pairs (m, 3): the vertex velocities of the tangent flow."""
     grad_prev, grad_next = _bending_gradients(T_prev, T_next)
     return -(grad_prev + grad_next)
 
@@ -404,7 +406,7 @@ def _binormal_velocity(T_prev: Array, T_next: Array) -> Array:
 
 @_jit
 def _vertex_tangent(gamma: Array, closed: bool) -> Array:
-    return _tangent_velocity(*_vertex_pairs(_unit_tangents(gamma, closed), closed))
+    return tangent_velocity(*_vertex_pairs(_unit_tangents(gamma, closed), closed))
 
 
 def vertex_tangent(gamma: Curve, closed: bool = False) -> Curve:
@@ -430,7 +432,7 @@ def _flow_pairs(gamma: Array, closed: bool) -> tuple[Array, Array]:
 
 @_jit
 def _tangent_flow(gamma: Array, closed: bool) -> Array:
-    return _on_vertices(_tangent_velocity(*_flow_pairs(gamma, closed)), closed)
+    return _on_vertices(tangent_velocity(*_flow_pairs(gamma, closed)), closed)
 
 
 @_jit

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from typing import Callable
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
@@ -109,9 +108,7 @@ def tangent_flow_on_tangents(T: Float[Array, "n 3"]) -> Float[Array, "n 3"]:
     """The discrete tangent flow (Prop 2.1) acting on the tangents of a closed curve:
     `∂_x T_k = v_{k+1} − v_k`, `v_k = (T_k + T_{k−1})/(1 + <T_k, T_{k−1}>)`, with v_k obtained by
     autodiff from the local bending energy as in `dg.curves.tangent_flow`."""
-    T_prev = jnp.roll(T, 1, axis=0)
-    grad_prev, grad_next = jax.vmap(jax.grad(dg.curves.local_bending_energy, argnums=(0, 1)))(T_prev, T)
-    v = -(grad_prev + grad_next)  # E_k = log 2 − log(1 + <T_k, T_{k−1}>): v_k = −(∇_{T_{k−1}} + ∇_{T_k}) E_k
+    v = dg.curves.tangent_velocity(jnp.roll(T, 1, axis=0), T)
     return jnp.roll(v, -1, axis=0) - v
 
 
