@@ -6,11 +6,16 @@ the residual it leaves Newton's quadratic convergence intact.  `μ` is given rel
 largest entry of `K`, so that it means the same whatever the scaling of the energy.
 
 Two interchangeable back ends, static and hashable, with the methods
-- `factor(kkt, w, mu_rel, identity_hessian=False) -> fac`: build (and for the dense
-  back end, LU-factorise) `K(w) + μS`;
+- `matrix(kkt, w, identity_hessian=False) -> K`: the KKT matrix at w (dense array, or the
+  coalesced values of the sparse pattern), evaluated once per Newton step and shared by:
+- `factor_matrix(kkt, K, mu_rel) -> fac`: `K + μS` (LU-factorised by the dense back end);
 - `apply(fac, b)`: solve with it (Newton's damping test reuses one factorisation);
-- `solve(...)`: both at once;
-- `lm_solve(kkt, w, nu, R)`: the Levenberg–Marquardt step `−(KᵀK + ν I)⁻¹ KᵀR`.
+- `matvec(K, v)`: `K v`;
+- `lm_solve_matrix(K, nu, R)`: the Levenberg–Marquardt step `−(KᵀK + ν I)⁻¹ KᵀR`;
+- `factor(kkt, w, mu_rel, identity_hessian=False)`, `solve(...)`: the compositions.
+Evaluating the second derivatives once per step (not again for the LM fallback and its model)
+keeps the compiled Newton loop small: compile time is dominated by the size of the traced
+graph, and the per-cell Hessians are its largest part.
 The sparse back end's index arrays enter the compiled solver as constants (it is a static
 argument of `jit`): XLA's gathers and scatters with constant indices are ~10× faster than
 with traced ones.
@@ -49,17 +54,21 @@ class DenseAlgebra:
     def __eq__(self, other):
         return isinstance(other, DenseAlgebra)
 
-    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
+    def matrix(self, kkt: KKT, w, identity_hessian=False):
         n, m = kkt.spec.n, kkt.spec.m
         if identity_hessian:
             u, _ = kkt.split(w)
             J = jax.jacfwd(kkt.g)(u)
-            K = jnp.block([[jnp.eye(n), -J.T], [-J, jnp.zeros((m, m))]])
-        else:
-            K = jax.hessian(kkt.lagrangian)(w)
+            return jnp.block([[jnp.eye(n), -J.T], [-J, jnp.zeros((m, m))]])
+        return jax.hessian(kkt.lagrangian)(w)
+
+    def factor_matrix(self, kkt: KKT, K, mu_rel):
         scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
-        K = K + jnp.diag(_regularisation(n, m, jnp.maximum(mu_rel * scale, MU_FLOOR)))
+        K = K + jnp.diag(_regularisation(kkt.spec.n, kkt.spec.m, jnp.maximum(mu_rel * scale, MU_FLOOR)))
         return _LU.init(lx.MatrixLinearOperator(K), {})
+
+    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
+        return self.factor_matrix(kkt, self.matrix(kkt, w, identity_hessian), mu_rel)
 
     def apply(self, fac, b):
         return _LU.compute(fac, b, {})[0]
@@ -67,8 +76,10 @@ class DenseAlgebra:
     def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
         return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
 
-    def lm_solve(self, kkt: KKT, w, nu, R):
-        K = jax.hessian(kkt.lagrangian)(w)
+    def matvec(self, K, v):
+        return K @ v
+
+    def lm_solve_matrix(self, K, nu, R):
         normal = K.T @ K + nu * jnp.eye(K.shape[0])
         return self.apply(_LU.init(lx.MatrixLinearOperator(normal), {}), -K.T @ R)
 
@@ -128,20 +139,23 @@ class SparseAlgebra:
     def __eq__(self, other):
         return isinstance(other, SparseAlgebra) and other.pattern.key == self.pattern.key
 
-    def _values(self, kkt: KKT, w, mu_rel, identity_hessian):
-        """Coalesced COO values of `K + μS` (K's Hessian block replaced by I if asked)."""
+    def matrix(self, kkt: KKT, w, identity_hessian=False):
+        """Coalesced COO values of K (K's Hessian block replaced by I if asked)."""
         n, m, p = kkt.spec.n, kkt.spec.m, self.pattern
         hess, jac = cell_blocks(p, kkt, w, identity_hessian)
         raw = jnp.concatenate([hess, -jac])
-        scale = jnp.maximum(jnp.max(jnp.abs(raw)) if raw.size else 1.0, 1.0)
-        diag = _regularisation(n, m, mu_rel * scale)
-        if identity_hessian:
-            diag = diag.at[:n].add(1.0)
+        diag = jnp.zeros((n + m,)).at[:n].add(1.0 if identity_hessian else 0.0)
         values = jnp.concatenate([raw[p.source], diag])
-        return jax.ops.segment_sum(values, p.target, num_segments=self.pattern.nnz)
+        return jax.ops.segment_sum(values, p.target, num_segments=p.nnz)
+
+    def factor_matrix(self, kkt: KKT, K, mu_rel):
+        n, m, p = kkt.spec.n, kkt.spec.m, self.pattern
+        scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
+        diagonal = p.target[p.source.shape[0]:]  # where the n + m diagonal entries were summed
+        return K.at[diagonal].add(_regularisation(n, m, jnp.maximum(mu_rel, MU_FLOOR) * scale))
 
     def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
-        return self._values(kkt, w, jnp.maximum(mu_rel, MU_FLOOR), identity_hessian)
+        return self.factor_matrix(kkt, self.matrix(kkt, w, identity_hessian), mu_rel)
 
     def apply(self, fac, b):
         split = self.pattern.split()
@@ -152,10 +166,13 @@ class SparseAlgebra:
     def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
         return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
 
-    def lm_solve(self, kkt: KKT, w, nu, R):
+    def matvec(self, K, v):
+        p = self.pattern
+        return jax.ops.segment_sum(K * v[p.cols], p.rows, num_segments=v.shape[0])
+
+    def lm_solve_matrix(self, K, nu, R):
         size = R.shape[0]
-        values = self._values(kkt, w, 0.0, False)
-        aug = jnp.concatenate([jnp.ones((size,)), values, values, jnp.full((size,), -nu)])
+        aug = jnp.concatenate([jnp.ones((size,)), K, K, jnp.full((size,), -nu)])
         rhs = jnp.concatenate([-R, jnp.zeros_like(R)])
         rows, cols, order = self.pattern.augmented()
         split = self.pattern.split(augmented=True)

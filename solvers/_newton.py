@@ -55,7 +55,7 @@ def _merit(R):
     return 0.5 * jnp.dot(R, R)
 
 
-def _newton_trial(kkt: KKT, algebra, w, R):
+def _newton_trial(kkt: KKT, algebra, K, w, R):
     """Damped Newton step with Deuflhard's affine-covariant monotonicity test.
 
     With the Newton correction `Δ = −K(w)⁻¹R(w)` and, for a trial `w + αΔ`, the simplified
@@ -66,37 +66,36 @@ def _newton_trial(kkt: KKT, algebra, w, R):
     `|Δ̄| = O(|Δ|²)` and α = 1: quadratic convergence.  Returns (α Δ, R(w + αΔ), accepted,
     at_roundoff), the last flag saying that the Newton correction is at the round-off level of
     w, so that a rejected step means the residual cannot be reduced further in float64.
+    `K = algebra.matrix(kkt, w)`.
     """
-    fac = algebra.factor(kkt, w, NEWTON_MU)
+    fac = algebra.factor_matrix(kkt, K, NEWTON_MU)
     delta = algebra.apply(fac, -R)
     size = jnp.linalg.norm(delta)
-
-    def trial(alpha):
-        R_new = kkt.residual(w + alpha * delta)
-        simplified = jnp.linalg.norm(algebra.apply(fac, -R_new))
-        ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & (simplified <= (1 - alpha / 4) * size)
-        return R_new, ok
 
     def cond(carry):
         alpha, _, ok = carry
         return (~ok) & (alpha > MIN_NEWTON_STEP)
 
     def body(carry):
+        # one trace of the trial (the loop starts at α = 2, so that its first trial is α = 1)
         alpha = 0.5 * carry[0]
-        return (alpha,) + trial(alpha)
+        R_new = kkt.residual(w + alpha * delta)
+        simplified = jnp.linalg.norm(algebra.apply(fac, -R_new))
+        ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & (simplified <= (1 - alpha / 4) * size)
+        return alpha, R_new, ok
 
-    one = jnp.asarray(1.0, w.dtype)
-    alpha, R_new, ok = jax.lax.while_loop(cond, body, (one,) + trial(one))
+    start = (jnp.asarray(2.0, w.dtype), R, jnp.asarray(False))
+    alpha, R_new, ok = jax.lax.while_loop(cond, body, start)
     at_roundoff = jnp.max(jnp.abs(delta)) <= ROUNDOFF * jnp.maximum(1.0, jnp.max(jnp.abs(w)))
     return alpha * delta, R_new, ok & jnp.isfinite(size), at_roundoff
 
 
-def _lm_trial(kkt: KKT, algebra, w, R, theta):
+def _lm_trial(kkt: KKT, algebra, K, w, R, theta):
     """One Levenberg–Marquardt trial; returns the step, new residual, acceptance and new θ."""
     nu = theta * jnp.linalg.norm(R)
-    d = algebra.lm_solve(kkt, w, nu, R)
+    d = algebra.lm_solve_matrix(K, nu, R)
     R_new = kkt.residual(w + d)
-    predicted = _merit(R) - _merit(R + kkt.kkt_matvec(w, d))
+    predicted = _merit(R) - _merit(R + algebra.matvec(K, d))
     actual = _merit(R) - _merit(R_new)
     rho = jnp.where(predicted > 0, actual / predicted, -1.0)
     rho = jnp.where(jnp.isfinite(rho) & jnp.all(jnp.isfinite(d)), rho, -1.0)
@@ -118,7 +117,8 @@ def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> New
         return s.status == RUNNING
 
     def body(s: NewtonState) -> NewtonState:
-        d, R_new, ok, at_roundoff = _newton_trial(kkt, algebra, s.w, s.R)
+        K = algebra.matrix(kkt, s.w)  # the second derivatives, once per step
+        d, R_new, ok, at_roundoff = _newton_trial(kkt, algebra, K, s.w, s.R)
         theta = jnp.where(ok, jnp.maximum(s.theta / 4, THETA_MIN), s.theta)
         stuck = (~ok) & at_roundoff
 
@@ -129,7 +129,7 @@ def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> New
             return ~carry[4] & ~stuck
 
         def lm_body(carry):
-            return _lm_trial(kkt, algebra, s.w, s.R, carry[3]) + (jnp.asarray(True),)
+            return _lm_trial(kkt, algebra, K, s.w, s.R, carry[3]) + (jnp.asarray(True),)
 
         d, R_new, ok, theta, _ = jax.lax.while_loop(lm_cond, lm_body, (d, R_new, ok, theta, ok))
         w = jnp.where(ok, s.w + d, s.w)

@@ -218,8 +218,10 @@ def test_klu_solve_with_sorted_indices_matches_dense():
     x = jax.jit(lambda w, b: algebra.solve(kkt, w, 0.0, b))(w, b)
     K = np.asarray(jax.jit(jax.hessian(kkt.lagrangian))(w))
     assert np.max(np.abs(K @ np.asarray(x) - np.asarray(b))) <= 1e-10
-    d = jax.jit(lambda w, b: algebra.lm_solve(kkt, w, 0.3, b))(w, b)  # (KᵀK + νI) d = −Kᵀ b
+    d = jax.jit(lambda w, b: algebra.lm_solve_matrix(algebra.matrix(kkt, w), 0.3, b))(w, b)  # (KᵀK + νI) d = −Kᵀ b
     assert np.max(np.abs((K.T @ K + 0.3 * np.eye(len(K))) @ np.asarray(d) + K.T @ np.asarray(b))) <= 1e-10
+    Kb = jax.jit(lambda w, b: algebra.matvec(algebra.matrix(kkt, w), b))(w, b)  # the assembled K times b
+    assert np.max(np.abs(np.asarray(Kb) - K @ np.asarray(b))) <= 1e-12 * np.max(np.abs(K @ np.asarray(b)))
 
 
 def test_finds_saddle_points_not_only_minima():
