@@ -53,6 +53,7 @@ __all__ = [
     "momentum",
     "hamiltonian",
     "vector_field",
+    "equations_of_motion",
     "initial_state",
     "conserved_quantities",
     "simulate",
@@ -129,14 +130,16 @@ def vector_field(*, alpha: float, a) -> Callable[[TopState], TopState]:
     with one derivative fewer)."""
     _check_parameters(alpha, a)
     a = jnp.asarray(a, dtype=float)
+    return jax.jit(lambda state: equations_of_motion(state, alpha, a))
 
-    def f(state: TopState) -> TopState:
-        Omega = _velocity_of_momentum(state.Phi, state.M, alpha, a)
-        dPhi = 0.5 * qt._mul(state.Phi, jnp.concatenate([jnp.zeros(1), Omega]))
-        torque = _body_derivative(lambda Phi: lagrangian(Phi, Omega, alpha=alpha, a=a), state.Phi)
-        return TopState(dPhi, jnp.cross(state.M, Omega) + torque)
 
-    return jax.jit(f)
+def equations_of_motion(state: TopState, alpha, a) -> TopState:
+    """`(Φ', M')` of `vector_field` without validation: traceable in α and a (for shooting,
+    `ddgjax.kirchhoff`)."""
+    Omega = _velocity_of_momentum(state.Phi, state.M, alpha, a)
+    dPhi = 0.5 * qt._mul(state.Phi, jnp.concatenate([jnp.zeros(1), Omega]))
+    torque = _body_derivative(lambda Phi: lagrangian(Phi, Omega, alpha=alpha, a=a), state.Phi)
+    return TopState(dPhi, jnp.cross(state.M, Omega) + torque)
 
 
 def _check_parameters(alpha, a) -> None:

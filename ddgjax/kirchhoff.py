@@ -1,0 +1,153 @@
+"""Smooth clamped elastic rods by the Kirchhoff analogy (Thm 3.11, Thm 3.13): shooting with the
+Lagrange top.
+
+By Thm 3.11 a framed arc-length curve (γ, Φ) is an elastic rod with torsion coefficient α iff its
+frame, read with arc length as time, is a motion of the Lagrange top (Sec 3.4.1) with inertia
+`J = diag(α, 1, 1)` and gravity `a` (the multiplier of the chord constraint): the rod functional
+`E_a = ∫ <ω, ω> + (α − 1)<ω, T>² + 2<a, T> ds` *is* the top's action (3.10).  A clamped rod on
+[0, L] with `Φ(0) = q0`, `Φ(L) = q1`, `γ(L) − γ(0) = c` is therefore the top motion from
+`(q0, M0)` that satisfies
+
+    Φ(L) = ±q1   (3 conditions: Im(q1⁻¹ Φ(L)) = 0),      ∫_0^L T ds = c   (3 conditions),
+
+six equations for the six unknowns (M0, a): the body angular momentum at s = 0 and the load.
+The top's equations of motion come from `ddgjax.top.equations_of_motion` (derived by autodiff
+of (3.10)), γ' = T = Φ i Φ⁻¹ is integrated alongside with diffrax (8th-order Dormand–Prince,
+tolerance 1e-13), and the shooting equations are solved by optimistix's Levenberg–Marquardt
+method with the Jacobian by forward-mode differentiation through the integrator.
+
+This is the *independent* smooth reference for the discrete rods of `energies.rod`: nothing
+here uses the discrete energy; the discrete solution only provides a starting guess (which
+also selects the branch when the clamped problem has several solutions).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import diffrax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+from jaxtyping import Array, Float
+
+from . import quaternion as qt
+from .errors import ConvergenceError, InvalidInputError
+from .top import TopState, equations_of_motion
+
+__all__ = ["SmoothRod", "shoot", "clamped_rod", "sample", "torsion", "discrete_top_residual"]
+
+E1 = jnp.array([1.0, 0.0, 0.0])
+RTOL = 1e-13
+
+
+class SmoothRod(NamedTuple):
+    """A smooth clamped rod: the initial frame and body momentum of its top motion, the load a,
+    the torsion coefficient α and the length L; `sample(rod, s)` evaluates it."""
+
+    Phi0: Float[Array, "4"]
+    M0: Float[Array, "3"]
+    a: Float[Array, "3"]
+    alpha: float
+    length: float
+
+
+def _field(s, y, args):
+    Phi, M, _gamma = y
+    alpha, a = args
+    d = equations_of_motion(TopState(Phi, M), alpha, a)
+    return d.Phi, d.M, qt._rotate(Phi, E1)
+
+
+def _integrate(Phi0, M0, a, alpha, length, ts):
+    """(Φ, M, γ) of the top motion at the arc lengths ts (γ(0) = 0)."""
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(_field),
+        diffrax.Dopri8(),
+        t0=0.0,
+        t1=length,
+        dt0=length / 64,
+        y0=(Phi0, M0, jnp.zeros(3)),
+        args=(alpha, a),
+        saveat=diffrax.SaveAt(ts=ts),
+        stepsize_controller=diffrax.PIDController(rtol=RTOL, atol=RTOL),
+        adjoint=diffrax.ForwardMode(),
+        max_steps=100_000,
+        throw=False,  # a diverging Newton iterate gives inf/NaN, caught by the final residual check
+    )
+    return sol.ys
+
+
+def shoot(z: Float[Array, "6"], Phi0, Phi1, chord, alpha, length) -> Float[Array, "6"]:
+    """The shooting residual of z = (M0, a): `(Im(Φ1⁻¹ Φ(L)), γ(L) − chord)`."""
+    Phi, _M, gamma = _integrate(Phi0, z[:3], z[3:], alpha, length, jnp.array([length]))
+    return jnp.concatenate([qt._mul(qt._conj(Phi1), Phi[0])[1:], gamma[0] - chord])
+
+
+def clamped_rod(
+    *, alpha: float, length: float = 1.0, chord, frame_start, frame_end, M0_guess, a_guess, tol: float = 1e-11
+) -> SmoothRod:
+    """The smooth clamped rod (Thm 3.13) with `Φ(0) = frame_start`, `Φ(L) = frame_end` and chord,
+    by shooting from the guess `(M0_guess, a_guess)` (e.g. from a discrete rod:
+    `M0 = 2 J Ω(0)`, `a = rod.load(solution)`).
+
+    **Raises:** `InvalidInputError` (α ≤ 0, non-unit frames), `ConvergenceError` if Newton does
+    not reach `tol` in the shooting residual.
+    """
+    if not (np.isfinite(alpha) and alpha > 0):
+        raise InvalidInputError(f"the torsion coefficient alpha must be positive, got {alpha}")
+    qt.check_unit(frame_start, "frame_start")
+    qt.check_unit(frame_end, "frame_end")
+    Phi0, Phi1 = jnp.asarray(frame_start, dtype=float), jnp.asarray(frame_end, dtype=float)
+    chord = jnp.asarray(chord, dtype=float)
+    args = (Phi0, Phi1, chord, float(alpha), float(length))
+    z0 = jnp.concatenate([jnp.asarray(M0_guess, dtype=float), jnp.asarray(a_guess, dtype=float)])
+    # Levenberg–Marquardt on |shoot|²: near a buckling load the shooting Jacobian is nearly
+    # singular and undamped Newton leaves the branch of the guess
+    sol = optx.least_squares(
+        lambda z, args: shoot(z, *args), optx.LevenbergMarquardt(rtol=tol, atol=tol), z0, args=args,
+        throw=False, max_steps=200,
+    )
+    residual = float(jnp.max(jnp.abs(shoot(sol.value, *args))))
+    if not residual <= 10 * tol:
+        raise ConvergenceError(
+            f"shooting for the smooth rod did not converge: residual {residual:.3e} > {tol:.1e} "
+            "(try a better guess, e.g. from a finer discrete rod)",
+            residual=residual, steps=int(sol.stats["num_steps"]), solution=sol.value,
+        )
+    return SmoothRod(Phi0, sol.value[:3], sol.value[3:], float(alpha), float(length))
+
+
+def sample(rod: SmoothRod, s) -> tuple[Float[Array, "m 4"], Float[Array, "m 3"]]:
+    """The frames Φ(s) and the centreline γ(s) (γ(0) = 0) at the arc lengths s (m,)."""
+    Phi, _M, gamma = _integrate(rod.Phi0, rod.M0, rod.a, rod.alpha, rod.length, jnp.asarray(s, dtype=float))
+    return Phi, gamma
+
+
+def torsion(rod: SmoothRod) -> float:
+    """The constant torsion τ = <ω, T> = Ω₁ = M₁/(2α) (Lemma 3.12; M = 2JΩ)."""
+    return float(rod.M0[0] / (2 * rod.alpha))
+
+
+def discrete_top_residual(Phi: Float[Array, "n 4"], h: float, alpha: float, a) -> Float[Array, "m 2 3"]:
+    """The residual of the top equations (Thm 3.13 (i)) `T' = ω × T`, `ω' = (1 − α)τT' + T × a`
+    on discrete edge frames Φ_k with edge length h, by central differences at the edges 1 … n−2.
+
+    At vertex k (between edges k−1 and k): `ω_k = 2 log(Φ_k Φ_{k−1}⁻¹)/h` (`Φ_k = exp(hω/2)Φ_{k−1}`)
+    and `T_k^v = (T_{k−1} + T_k)/|T_{k−1} + T_k|`; at edge k: `T' = (T_{k+1}^v − T_k^v)/h`,
+    `ω = (ω_k + ω_{k+1})/2`, `ω' = (ω_{k+1} − ω_k)/h`, `τ = <ω, T_k>`.  Both rows of the result
+    are O(h²) on samples of a smooth rod (Thm 3.11: a rod's frame is a top motion).
+    """
+    Phi = jnp.asarray(Phi, dtype=float)
+    T = qt._rotate(Phi, E1)
+    omega = 2 * qt._log(qt._mul(Phi[1:], qt._conj(Phi[:-1]))) / h
+    Tv = T[:-1] + T[1:]
+    Tv = Tv / jnp.linalg.norm(Tv, axis=-1, keepdims=True)
+    Te = T[1:-1]
+    dT = (Tv[1:] - Tv[:-1]) / h
+    w = 0.5 * (omega[1:] + omega[:-1])
+    dw = (omega[1:] - omega[:-1]) / h
+    tau = jnp.sum(w * Te, axis=-1, keepdims=True)
+    r1 = dT - jnp.cross(w, Te)
+    r2 = dw - (1 - alpha) * tau * dT - jnp.cross(Te, jnp.asarray(a, dtype=float))
+    return jnp.stack([r1, r2], axis=1)
