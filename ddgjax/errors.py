@@ -102,3 +102,37 @@ class TriangleInequalityError(MeshError):
     """Edge lengths violate a triangle inequality on some face (Sec 5.3); the message names the
     face and its three lengths.
     """
+
+
+class GluingError(MeshError):
+    """A gluing of triangles is inconsistent (Def 5.6): a halfedge glued to itself or to a side
+    that is not glued back, an index out of range, or two glued sides of different lengths.  The
+    message names the halfedge (side `i` of face `f` is halfedge `3 f + i`).
+    """
+
+
+class FlipBudgetError(DDGError, RuntimeError):
+    """The edge-flip algorithm (Fig 7.13) used up its flip budget before every edge was Delaunay.
+
+    Theorem 7.12 guarantees termination in exact arithmetic; the budget only guards against a
+    hang.  The message names the number of flips done and an edge that is still not Delaunay.
+    """
+
+
+__all__ += ["GluingError", "FlipBudgetError"]
+
+
+class DegenerateFaceError(MeshError):
+    """A triangle has zero area (up to round-off): its cotangents and the gradient of an affine
+    function on it are undefined (Sec 6.3).  The message names the face and its vertices.
+    """
+
+
+class NonUniqueSolutionError(InvalidInputError):
+    """A discrete Dirichlet boundary value problem has no unique solution: a connected component
+    of the graph holds no boundary vertex, so constants can be added there (Cor 6.3, Thm 6.5).
+    The message names a vertex of that component.
+    """
+
+
+__all__ += ["DegenerateFaceError", "NonUniqueSolutionError"]

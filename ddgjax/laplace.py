@@ -1,0 +1,416 @@
+"""Graph and cotan Laplacians (Sec 6.2, 6.3 of the reference), assembled as scipy sparse matrices.
+
+**Sign.**  We follow the reference (Def 6.1, Def 6.2): the Laplacian is positive semidefinite,
+
+    (L f)_i = Σ_{j:(ij)∈E} ν(ij) (f_i − f_j),        E(f) = ½ Σ_{(ij)∈E} ν(ij) (f_i − f_j)² = ½ fᵀ L f,
+
+so `L = ∇²E` and `L·1 = 0`.  libigl's `cotmatrix` is the negative semidefinite `−L`; the smooth
+Laplacian is `Δf(x_i) ≈ −(L f)_i / M_i` with `M_i` the vertex area (`barycentric_areas`).
+
+**Where the cotan weights come from.**  The Dirichlet energy of the affine interpolant on one
+triangle (Sec 6.3) is declared from the triangle's positions alone (`triangle_dirichlet_energy`:
+`½ A |∇f|²`, written with the Gram matrix of two edges, no angles).  Its 3×3 Hessian in the vertex
+values, taken by autodiff (`triangle_stiffness`), is the local stiffness matrix whose off-diagonal
+entry at the edge opposite corner k is `−½ cot α_k` (Thm 6.6); the sparse Laplacian is the sum of
+these blocks (finite-element assembly: a `bincount` into the csr structure of F, which is built
+once per connectivity and cached), i.e. the cotan weights (6.2)
+
+    ν(ij) = ½ (cot α_ij + cot α_ji) on interior edges,   ν(ij) = ½ cot α_ij on boundary edges.
+
+The autodiff Hessian is jit-compiled (XLA fuses it into one pass over the faces); it is faster
+than the closed-form cotangent formula in numpy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import scipy.sparse as sp
+from jaxtyping import Array, Float, Int
+from scipy.sparse.csgraph import connected_components
+from scipy.sparse.linalg import splu
+
+from ._checks import check_finite
+from .errors import (
+    DegenerateFaceError,
+    InvalidInputError,
+    MeshError,
+    NonFiniteError,
+    NonUniqueSolutionError,
+    ShapeError,
+)
+
+__all__ = [
+    "barycentric_areas",
+    "boundary_indices",
+    "check_nondegenerate",
+    "check_unique",
+    "checked_triangle_mesh",
+    "cotan_laplacian",
+    "cotan_weights",
+    "dirichlet_solve",
+    "edge_cotan_weights",
+    "graph_laplacian",
+    "triangle_area",
+    "triangle_dirichlet_energy",
+    "triangle_stiffness",
+]
+
+# A face is degenerate when |e1 × e2|² ≤ DEGENERATE |e1|²|e2|², i.e. the sine of its angle at
+# corner 0 is below ~1e-7: there the cotangents are round-off.
+DEGENERATE = 1e-14
+
+
+def _twice_area_squared(e1, e2):
+    n = jnp.cross(e1, e2)
+    return jnp.dot(n, n)
+
+
+def triangle_dirichlet_energy(f: Float[Array, "3"], P: Float[Array, "3 3"]) -> Float[Array, ""]:
+    """Dirichlet energy of the affine interpolant of the values f on the triangle P (Sec 6.3):
+
+        E_F(f) = ½ ∫_F |∇f|² dA = ½ A |∇f|²,    |∇f|² = dᵀ G⁻¹ d,   A = ½ √det G,
+
+    with the edges e1 = P1 − P0, e2 = P2 − P0, their Gram matrix G and d = (f1 − f0, f2 − f0).
+    It equals ¼ Σ_i cot α_i (f_{i+1} − f_{i−1})² (Sec 6.3), but is written without angles, so
+    its Hessian in f (by autodiff) *derives* the cotan weights (Thm 6.6).
+    """
+    e1, e2 = P[1] - P[0], P[2] - P[0]
+    g11, g12, g22 = jnp.dot(e1, e1), jnp.dot(e1, e2), jnp.dot(e2, e2)
+    d1, d2 = f[1] - f[0], f[2] - f[0]
+    return (g22 * d1 * d1 - 2.0 * g12 * d1 * d2 + g11 * d2 * d2) / (4.0 * jnp.sqrt(_twice_area_squared(e1, e2)))
+
+
+def triangle_area(P: Float[Array, "3 3"]) -> Float[Array, ""]:
+    """A(F) = ½ |(P1 − P0) × (P2 − P0)| (Sec 6.4)."""
+    return 0.5 * jnp.sqrt(_twice_area_squared(P[1] - P[0], P[2] - P[0]))
+
+
+def _stiffness(P):
+    return jax.vmap(jax.hessian(triangle_dirichlet_energy), in_axes=(None, 0))(jnp.zeros(3, P.dtype), P)
+
+
+def _sin2(P):
+    """sin² of each face's angle at corner 0 (0 for a zero-area face, NaN for a zero edge)."""
+    e1, e2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
+    return jax.vmap(_twice_area_squared)(e1, e2) / (jnp.sum(e1 * e1, 1) * jnp.sum(e2 * e2, 1))
+
+
+@jax.jit
+def _shape(V, F):
+    return _sin2(V[F])
+
+
+@jax.jit
+def _stiffness_and_shape(V, F):
+    P = V[F]
+    return _stiffness(P), _sin2(P)
+
+
+@jax.jit
+def _half_cotangents_and_shape(V, F):
+    """(nf, 3) off-diagonal stiffness entries −K[k+1, k+2] = ½ cot α_k, and `_sin2`."""
+    P = V[F]
+    K = _stiffness(P)
+    return -K[:, jnp.array([1, 2, 0]), jnp.array([2, 0, 1])], _sin2(P)
+
+
+def _as_positions(V) -> np.ndarray:
+    V = np.asarray(V, dtype=np.float64)
+    if V.ndim != 2 or V.shape[1] not in (2, 3):
+        raise ShapeError(f"V must have shape (nv, 3) (or (nv, 2) for planar meshes), got {V.shape}")
+    if V.shape[1] == 2:
+        V = np.hstack([V, np.zeros((V.shape[0], 1))])
+    bad = np.flatnonzero(~np.all(np.isfinite(V), axis=1))
+    if bad.size:
+        raise NonFiniteError(f"vertex {bad[0]} has the non-finite position {V[bad[0]].tolist()}")
+    return V
+
+
+def _as_triangles(F, n_vertices: int) -> np.ndarray:
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3 or not np.issubdtype(F.dtype, np.integer):
+        raise ShapeError(f"F must be an (nf, 3) integer array of triangles, got {F.dtype} {F.shape}")
+    out = (F < 0) | (F >= n_vertices)
+    if out.any():
+        f = int(np.argmax(out.any(axis=1)))
+        raise MeshError(f"face {f} {F[f].tolist()} has a vertex index outside 0..{n_vertices - 1}")
+    return F.astype(np.int64)
+
+
+def checked_triangle_mesh(V, F, *, manifold: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """`(V, F)` as float64 (nv, 3) and int64 (nf, 3) arrays, validated (the inputs are not changed).
+
+    **Raises:** `ShapeError` (shapes), `NonFiniteError` (NaN/inf position, naming the vertex),
+    `MeshError` (index out of range, naming the face); with `manifold=True` also the checks of
+    `mesh.from_faces` (`NonManifoldError` naming the edge or vertex, a face repeating a vertex).
+    Zero-area faces are detected where the geometry is computed (`DegenerateFaceError`).
+    """
+    V = _as_positions(V)
+    F = _as_triangles(F, V.shape[0])
+    if manifold:
+        from .mesh.connectivity import from_faces
+
+        from_faces(F, n_vertices=V.shape[0])
+    return V, F
+
+
+def triangle_stiffness(V, F) -> np.ndarray:
+    """(nf, 3, 3): the Hessian of `triangle_dirichlet_energy` in the vertex values, per face, by
+    autodiff; entry [k+1, k+2] (indices mod 3) is −½ cot α_k (Sec 6.3).
+
+    **Raises:** as `checked_triangle_mesh`, and `DegenerateFaceError` naming a zero-area face.
+    """
+    return _per_face(_stiffness_and_shape, V, F)[0]
+
+
+def _per_face(kernel, V, F) -> tuple[np.ndarray, np.ndarray]:
+    """`(kernel's per-face output, F)` for a validated mesh whose faces all have non-zero area."""
+    V, F = checked_triangle_mesh(V, F)
+    out, sin2 = kernel(V, F)
+    out, sin2 = np.asarray(out), np.asarray(sin2)
+    _check_areas(sin2, F)
+    return out, F
+
+
+def check_nondegenerate(V, F) -> None:
+    """Raise `DegenerateFaceError` naming the first face of zero area (sin of its angle at
+    corner 0 below ~1e-7), after the checks of `checked_triangle_mesh`."""
+    V, F = checked_triangle_mesh(V, F)
+    _check_areas(np.asarray(_shape(V, F)), F)
+
+
+def _check_areas(sin2, F) -> None:
+    bad = np.flatnonzero(~(sin2 > DEGENERATE))
+    if bad.size:
+        f = int(bad[0])
+        raise DegenerateFaceError(
+            f"face {f} {F[f].tolist()} has zero area (sin² of its angle {sin2[f]:.1e}): its cotangents "
+            "are undefined; remove or repair degenerate triangles"
+        )
+
+
+def _corner_weights(V, F) -> tuple[np.ndarray, np.ndarray]:
+    """Each face's contribution ½ cot α_k to the edge opposite corner k, (nf, 3), and F."""
+    return _per_face(_half_cotangents_and_shape, V, F)
+
+
+@dataclass(frozen=True, eq=False)
+class _Pattern:
+    """The csr structure of L for edge entries (i_k, j_k) and where each entry lands in it.
+
+    `slot[k]`: the position of (i_k, j_k) in `indices`; `transpose[s]`: the position of (c, r)
+    for the entry (r, c) at s; `diagonal[v]`: the position of (v, v).
+    """
+
+    key: np.ndarray
+    i: np.ndarray
+    j: np.ndarray
+    indptr: np.ndarray
+    indices: np.ndarray
+    slot: np.ndarray
+    transpose: np.ndarray
+    diagonal: np.ndarray
+
+
+_PATTERNS: list[_Pattern] = []  # the few most recent, newest last (a minimal-surface iteration reuses one)
+_PATTERN_CACHE_SIZE = 4
+
+
+def _build_pattern(key, i, j, n: int) -> _Pattern:
+    k = np.arange(n, dtype=i.dtype)
+    rows, cols = np.concatenate([i, j, k]), np.concatenate([j, i, k])
+    structure = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
+    structure.sum_duplicates()
+    row_of = np.repeat(np.arange(n, dtype=np.int64), np.diff(structure.indptr))
+    flat = row_of * n + structure.indices  # sorted: rows ascending, columns sorted within rows
+    position = lambda r, c: np.searchsorted(flat, r.astype(np.int64) * n + c)
+    return _Pattern(key.copy(), i, j, structure.indptr, structure.indices, position(i, j),
+                    position(structure.indices, row_of), position(k, k))
+
+
+def _pattern(key: np.ndarray, n: int, entries) -> _Pattern:
+    """The cached `_Pattern` of this connectivity (`key`: F or the edge list); `entries()` gives
+    the edge entries `(i, j)` when it has to be built."""
+    for pattern in _PATTERNS:
+        if pattern.indptr.size == n + 1 and pattern.key.shape == key.shape and np.array_equal(pattern.key, key):
+            return pattern
+    pattern = _build_pattern(key, *entries(), n)
+    _PATTERNS.append(pattern)
+    del _PATTERNS[:-_PATTERN_CACHE_SIZE]
+    return pattern
+
+
+def _laplacian(pattern: _Pattern, w) -> sp.csr_matrix:
+    """L = diag(Σ_j ν_ij) − W from the entries w at (pattern.i, pattern.j) (several entries of one
+    edge are summed: one per face), assembled into the cached csr structure."""
+    n = pattern.indptr.size - 1
+    oriented = np.bincount(pattern.slot, w, pattern.indices.size)
+    data = -(oriented + oriented[pattern.transpose])
+    data[pattern.diagonal] = np.bincount(pattern.i, w, n) + np.bincount(pattern.j, w, n)
+    # copies: scipy methods such as eliminate_zeros change a matrix's index arrays in place
+    return sp.csr_matrix((data, pattern.indices.copy(), pattern.indptr.copy()), shape=(n, n))
+
+
+def _face_edges(F):
+    """`(i, j)`, (3 nf,): the edge opposite each corner k, (F[k+1], F[k+2])."""
+    F = F.astype(np.int32) if F.size and F.max() < 2**31 - 1 else F
+    return F[:, [1, 2, 0]].reshape(-1), F[:, [2, 0, 1]].reshape(-1)
+
+
+def cotan_laplacian(V, F) -> sp.csr_matrix:
+    """The cotan Laplacian (Def 6.2), (nv, nv) csr, positive semidefinite:
+    (L f)_i = Σ_j ν(ij) (f_i − f_j), the autodiff Hessian of the Dirichlet energy (Thm 6.6).
+
+    libigl's `cotmatrix(V, F)` is `−L`.  `V` (nv, 3) or (nv, 2), `F` (nf, 3) int.  The csr
+    structure of a connectivity F is computed on first use and cached (the last few F), so that
+    repeated assembly on one mesh (Fig 6.5) costs a jit call and a `bincount`.
+    **Raises:** as `triangle_stiffness` (manifoldness is not checked here: the Laplacian of any
+    triangle soup is defined; the problem constructors of `energies` check it).
+    """
+    w, F = _corner_weights(V, F)
+    n = np.shape(V)[0]
+    return _laplacian(_pattern(F, n, lambda: _face_edges(F)), w.reshape(-1))
+
+
+def cotan_weights(V, F) -> sp.csr_matrix:
+    """The symmetric (nv, nv) matrix W of cotan weights (6.2): W_ij = ν(ij) on edges, 0 elsewhere.
+
+    ν(ij) = ½ (cot α_ij + cot α_ji) on interior edges, ½ cot α_ij on boundary edges (Thm 6.6);
+    negative where α_ij + α_ji > π (eq 6.3).  **Raises:** as `triangle_stiffness`.
+    """
+    L = cotan_laplacian(V, F)
+    W = sp.diags(L.diagonal()) - L
+    W.eliminate_zeros()
+    return W.tocsr()
+
+
+def edge_cotan_weights(V, F) -> tuple[np.ndarray, np.ndarray]:
+    """`(edges, ν)`: the edges of F as in `mesh.edges(F)` (sorted, i < j) and their cotan weights
+    (edges of weight exactly 0, such as the diagonals of a square grid, included)."""
+    L = cotan_laplacian(V, F).tocoo()  # the cached structure holds every edge, zero or not
+    upper = L.row < L.col
+    edges_ = np.stack([L.row[upper], L.col[upper]], axis=1).astype(np.int64)
+    order = np.lexsort((edges_[:, 1], edges_[:, 0]))
+    return edges_[order], -L.data[upper][order]
+
+
+def graph_laplacian(edges: Int[np.ndarray, "ne 2"], weights: np.ndarray, n_vertices: int | None = None) -> sp.csr_matrix:
+    """The Laplacian of a weighted graph (Def 6.1): (L f)_i = Σ_{j:(ij)∈E} ν(ij) (f_i − f_j).
+
+    **Raises:** `ShapeError` for edges not (ne, 2) int or weights not (ne,), `InvalidInputError`
+    for a negative index, a loop (i, i) or a vertex index ≥ n_vertices (naming the edge),
+    `NonFiniteError` for a NaN weight (naming the edge).
+    """
+    edges, weights, n = checked_graph(edges, weights, n_vertices)
+    return _laplacian(_pattern(edges, n, lambda: (edges[:, 0], edges[:, 1])), weights)
+
+
+def checked_graph(edges, weights, n_vertices=None) -> tuple[np.ndarray, np.ndarray, int]:
+    """`(edges, weights, n_vertices)` validated copies (see `graph_laplacian`)."""
+    edges = np.array(edges)
+    if edges.ndim != 2 or edges.shape[1] != 2 or not np.issubdtype(edges.dtype, np.integer):
+        raise ShapeError(f"edges must be an (ne, 2) integer array, got {edges.dtype} {edges.shape}")
+    weights = np.array(weights, dtype=np.float64)
+    if weights.shape != (edges.shape[0],):
+        raise ShapeError(f"weights must have shape ({edges.shape[0]},), one per edge, got {weights.shape}")
+    bad = np.flatnonzero(~np.isfinite(weights))
+    if bad.size:
+        raise NonFiniteError(f"edge {bad[0]} {edges[bad[0]].tolist()} has the non-finite weight {weights[bad[0]]}")
+    n = int(edges.max()) + 1 if n_vertices is None and edges.size else int(n_vertices or 0)
+    for k, reason in ((np.flatnonzero((edges < 0).any(1)), "a negative vertex index"),
+                      (np.flatnonzero((edges >= n).any(1)), f"a vertex index >= n_vertices = {n}"),
+                      (np.flatnonzero(edges[:, 0] == edges[:, 1]), "a loop (both ends equal)")):
+        if k.size:
+            raise InvalidInputError(f"edge {k[0]} {edges[k[0]].tolist()} has {reason}")
+    return edges.astype(np.int64), weights, n
+
+
+def barycentric_areas(V, F) -> np.ndarray:
+    """(nv,): M_i = ⅓ Σ_{F ∋ i} A(F), the lumped (barycentric) vertex area; −(L f)_i / M_i → Δf."""
+    V, F = checked_triangle_mesh(V, F)
+    A = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    return np.bincount(F.reshape(-1), np.repeat(A / 3.0, 3), V.shape[0])
+
+
+def boundary_indices(boundary, n_vertices: int) -> np.ndarray:
+    """The boundary vertex set V₀ as sorted unique int64 indices; `boundary` is an index array or
+    a bool mask of length n_vertices.  **Raises:** `InvalidInputError` naming an index outside
+    0..n_vertices−1 or a repeated index, `ShapeError` for a mask of the wrong length."""
+    b = np.array(boundary)
+    if b.dtype == bool:
+        if b.shape != (n_vertices,):
+            raise ShapeError(f"a boundary mask needs shape ({n_vertices},), got {b.shape}")
+        return np.flatnonzero(b).astype(np.int64)
+    b = b.reshape(-1)
+    if b.size and not np.issubdtype(b.dtype, np.integer):
+        raise ShapeError(f"boundary must be vertex indices (integers) or a bool mask, got dtype {b.dtype}")
+    out = np.flatnonzero((b < 0) | (b >= n_vertices))
+    if out.size:
+        raise InvalidInputError(
+            f"boundary vertex {b[out[0]]} (entry {out[0]}) does not exist: vertices are 0..{n_vertices - 1}"
+        )
+    unique, counts = np.unique(b, return_counts=True)
+    if np.any(counts > 1):
+        raise InvalidInputError(f"boundary vertex {unique[counts > 1][0]} is listed more than once")
+    return b.astype(np.int64)
+
+
+def check_unique(L: sp.spmatrix, boundary: np.ndarray) -> None:
+    """Raise `NonUniqueSolutionError` unless every connected component of the graph of L holds a
+    boundary vertex (otherwise constants can be added on it: Cor 6.3), naming a vertex of it."""
+    n_comp, label = connected_components(abs(L) > 0, directed=False)
+    has_boundary = np.zeros(n_comp, dtype=bool)
+    has_boundary[label[boundary]] = True
+    if not has_boundary.all():
+        c = int(np.argmin(has_boundary))
+        v = int(np.argmax(label == c))
+        raise NonUniqueSolutionError(
+            f"the component containing vertex {v} has no boundary vertex: the Dirichlet problem's "
+            "solution is not unique there (any constant can be added, Cor 6.3); add a boundary vertex to it"
+        )
+
+
+def dirichlet_solve(L: sp.spmatrix, boundary, values) -> np.ndarray:
+    """The solution of the discrete Dirichlet boundary value problem (dDBVP, Cor 6.4, Thm 6.5):
+
+        (L f)_i = 0 for i ∉ V₀,   f_i = c_i for i ∈ V₀,
+
+    by one sparse LU factorisation of the interior block, `L_II f_I = −L_IB c`.
+
+    **Arguments:** `L` (nv, nv) sparse; `boundary` V₀ (indices, or a bool mask); `values` c,
+    (nb,) or (nb, k) for k right-hand sides (e.g. the coordinates of a surface, Fig 6.5),
+    ordered like `boundary` (like its True entries for a mask).
+    **Returns:** f, (nv,) or (nv, k).
+    **Raises:** `InvalidInputError` for a boundary index that does not exist, `NonFiniteError`
+    for NaN values, `NonUniqueSolutionError` when a component has no boundary vertex or the
+    interior block is singular (possible with negative weights).
+    """
+    L = sp.csr_matrix(L)
+    n = L.shape[0]
+    b = boundary_indices(boundary, n)
+    c = np.array(values, dtype=np.float64)
+    if c.shape[:1] != (b.size,) or c.ndim > 2:
+        raise ShapeError(f"values must have shape ({b.size},) or ({b.size}, k), one row per boundary vertex, got {c.shape}")
+    check_finite(c, "values")
+    check_unique(L, b)
+    interior = np.ones(n, dtype=bool)
+    interior[b] = False
+    inner = np.flatnonzero(interior)
+    f = np.zeros((n,) + c.shape[1:])
+    f[b] = c
+    if inner.size == 0:
+        return f
+    rows = L[inner]
+    try:
+        lu = splu(rows[:, inner].tocsc(), permc_spec="MMD_AT_PLUS_A")
+    except RuntimeError as err:
+        raise NonUniqueSolutionError(
+            f"the interior block of the Laplacian is singular ({err}): the Dirichlet problem has no unique "
+            "solution (possible with negative weights, eq 6.3)"
+        ) from None
+    f[inner] = lu.solve(-(rows[:, b] @ c))
+    return f

@@ -1,0 +1,79 @@
+"""Figures of harmonic functions and simplicial minimal surfaces (Sec 6), matplotlib Agg.
+
+matplotlib is imported inside the functions, never when ddgjax is imported.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ShapeError
+from .mesh import angle_defect
+from .mesh.connectivity import from_faces
+from .mesh.curvature import boundary_vertex_mask
+from .plot_surface import surface
+
+__all__ = ["harmonic_function", "minimal_surface"]
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def harmonic_function(V, F, f, path, *, title: str = "discrete harmonic function", cmap: str = "viridis") -> Path:
+    """Draw the piecewise affine function f (nv,) on the triangle mesh (V, F) and save it to `path`.
+
+    Planar meshes (z ≡ const) are drawn flat with Gouraud shading (`tripcolor`) and contour
+    lines; others in 3D with faces coloured by the mean of f over their vertices.
+    **Raises:** `ShapeError` when f does not have one value per vertex.
+    """
+    V, F, f = np.asarray(V, float), np.asarray(F), np.asarray(f, float)
+    if f.shape != (len(V),):
+        raise ShapeError(f"f must have one value per vertex, shape ({len(V)},), got {f.shape}")
+    if V.shape[1] == 3 and np.ptp(V[:, 2]) > 1e-12 * max(np.ptp(V), 1e-300):
+        return Path(surface(V, F, path, color_by=f[F].mean(axis=1), cmap=cmap, title=title))
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5.0, 4.5))
+    shading = ax.tripcolor(V[:, 0], V[:, 1], F, f, shading="gouraud", cmap=cmap)
+    ax.tricontour(V[:, 0], V[:, 1], F, f, levels=12, colors="k", linewidths=0.4)
+    ax.triplot(V[:, 0], V[:, 1], F, color="w", linewidth=0.15, alpha=0.5)
+    ax.set_aspect("equal")
+    ax.set_title(title)
+    fig.colorbar(shading, ax=ax, shrink=0.8, label="f")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def minimal_surface(V, F, path, *, history=None, title: str = "simplicial minimal surface") -> Path:
+    """Draw a simplicial minimal surface coloured by its angle defect K at the interior vertices
+    (Def 5.2; a minimal surface is saddle-shaped, K ≤ 0; boundary vertices count 0, so that their
+    turning angles do not swamp the scale), and, when `history` (the area-gradient residuals of
+    `energies.area.minimal_surface`'s `info`) is given, its convergence next to it.
+    """
+    path = Path(path)
+    F = np.asarray(F)
+    K = np.where(boundary_vertex_mask(from_faces(F, n_vertices=len(V))), 0.0, np.asarray(angle_defect(V, F)))
+    surface(V, F, path, color_by=K[F].mean(axis=1), title=title)
+    if history is None:
+        return path
+    plt = _pyplot()
+    history = np.asarray(history, float)
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.5), gridspec_kw={"width_ratios": [1.2, 1]})
+    left.imshow(plt.imread(path))
+    left.axis("off")
+    right.semilogy(np.arange(len(history)), np.maximum(history, 1e-300), "o-", markersize=3)
+    right.set_xlabel("iteration")
+    right.set_ylabel("max |∇A| at interior vertices")
+    right.set_title("convergence")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

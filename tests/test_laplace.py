@@ -1,0 +1,186 @@
+"""Cotan and graph Laplacians (Sec 6.2, 6.3): Thm 6.6 by autodiff, libigl, invariants, smooth
+limits on regular planar triangulations, bad input, plots."""
+
+import jax
+import numpy as np
+import pytest
+
+import ddgjax as dg
+from ddgjax.errors import (
+    DegenerateFaceError,
+    InvalidInputError,
+    MeshError,
+    NonFiniteError,
+    NonManifoldError,
+)
+from energies import dirichlet
+
+
+def random_disk(seed, rings=3, m=9, lift=0.3):
+    """A disk mesh with interior and boundary edges, vertices jittered in 3D."""
+    V, F = dg.mesh.disk(rings, m)
+    rng = np.random.default_rng(seed)
+    V = V + 0.04 * rng.normal(size=V.shape)
+    V[:, 2] += lift * rng.normal(size=len(V)) * 0.3
+    return V, F
+
+
+def cotan_laplacian_from_angles(V, F):
+    """Oracle: eq (6.2) assembled in a loop from the corner angles of `mesh.corner_angles`."""
+    alpha = np.asarray(dg.mesh.corner_angles(V, F))
+    L = np.zeros((len(V), len(V)))
+    for f, face in enumerate(F):
+        for k in range(3):
+            i, j = face[(k + 1) % 3], face[(k + 2) % 3]
+            w = 0.5 / np.tan(alpha[f, k])
+            L[i, j] -= w
+            L[j, i] -= w
+            L[i, i] += w
+            L[j, j] += w
+    return L
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_thm_6_6_autodiff_hessian_is_cotan_laplacian(seed):
+    V, F = random_disk(seed)
+    problem = dirichlet.cotan(V, F, [0], [0.0])
+    hessian = np.asarray(jax.jit(jax.hessian(problem.energy))(np.zeros(len(V)), problem.params))
+    oracle = cotan_laplacian_from_angles(V, F)
+    L = dg.laplace.cotan_laplacian(V, F).toarray()
+    assert np.max(np.abs(hessian - oracle)) < 1e-12
+    assert np.max(np.abs(L - oracle)) < 1e-12
+    # the mesh has both kinds of edges (one face at boundary edges: ½ cot α)
+    boundary = dg.mesh.boundary_loops(F)[0]
+    i, j = boundary[0], boundary[1]
+    (f,) = [f for f, face in enumerate(F) if i in face and j in face]
+    k = next(c for c in range(3) if F[f, c] not in (i, j))
+    alpha = np.asarray(dg.mesh.corner_angles(V, F))[f, k]
+    assert abs(-L[i, j] - 0.5 / np.tan(alpha)) < 1e-12
+
+
+def test_triangle_dirichlet_energy_is_the_cotan_formula():
+    """Sec 6.3: ½ A |∇f|² = ¼ Σ cot α_i (f_{i+1} − f_{i−1})² on one triangle."""
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        P, f = rng.normal(size=(3, 3)), rng.normal(size=3)
+        alpha = np.asarray(dg.mesh.corner_angles(P, np.array([[0, 1, 2]])))[0]
+        cot_form = 0.25 * sum((f[(i + 1) % 3] - f[(i - 1) % 3]) ** 2 / np.tan(alpha[i]) for i in range(3))
+        assert abs(float(dg.laplace.triangle_dirichlet_energy(f, P)) - cot_form) < 1e-12 * (1 + abs(cot_form))
+
+
+def test_cotan_laplacian_matches_libigl():
+    igl = pytest.importorskip("igl")
+    for V, F in [random_disk(4), dg.mesh.icosphere(2), dg.mesh.torus(12, 7)]:
+        L = dg.laplace.cotan_laplacian(V, F)
+        assert abs(L + igl.cotmatrix(V, F)).max() < 1e-12 * abs(L).max()
+
+
+def test_laplacian_invariants():
+    """L 1 = 0, L symmetric, weights scale invariant, E(f) = ½ fᵀ L f, edge weights in edges(F) order."""
+    V, F = random_disk(5)
+    L = dg.laplace.cotan_laplacian(V, F)
+    assert np.max(np.abs(L @ np.ones(len(V)))) < 1e-13
+    assert abs(L - L.T).max() == 0
+    L.data[:] = 0.0
+    L.eliminate_zeros()  # changing a returned matrix in place leaves the cached structure alone
+    L = dg.laplace.cotan_laplacian(V, F)
+    assert abs(L - L.T).max() == 0 and L.nnz == len(V) + 2 * len(dg.mesh.edges(F))
+    assert abs(dg.laplace.cotan_laplacian(3.7 * V, F) - L).max() < 1e-12
+    E, w = dg.laplace.edge_cotan_weights(V, F)
+    assert np.array_equal(E, dg.mesh.edges(F))
+    f = np.random.default_rng(0).normal(size=len(V))
+    assert abs(0.5 * f @ (L @ f) - 0.5 * np.sum(w * (f[E[:, 0]] - f[E[:, 1]]) ** 2)) < 1e-12
+    W = dg.laplace.cotan_weights(V, F)
+    assert np.max(np.abs(np.asarray(W.sum(axis=1)).ravel() - L.diagonal())) < 1e-13
+    assert abs(dg.laplace.graph_laplacian(E, w, len(V)) - L).max() < 1e-13
+
+
+def test_edge_weights_keep_zero_weight_edges():
+    """On the square grid the diagonals have ν = ½ (cot 90° + cot 90°) = 0 (to round-off)."""
+    V, F, _ = square_grid(4)
+    E, w = dg.laplace.edge_cotan_weights(V, F)
+    assert np.array_equal(E, dg.mesh.edges(F))
+    diagonal = np.abs(V[E[:, 0], 0] - V[E[:, 1], 0]) * np.abs(V[E[:, 0], 1] - V[E[:, 1], 1]) > 0
+    assert np.max(np.abs(w[diagonal])) < 1e-15
+    assert np.array_equal(np.unique(np.round(w[~diagonal], 12)), [0.5, 1.0])  # boundary ½ cot 45°, interior 1
+
+
+def test_graph_laplacian_example_6_1():
+    """Example 6.1 on a path (G = Z): (Δf)(n) = 2 f(n) − f(n+1) − f(n−1)."""
+    n = 6
+    edges = np.stack([np.arange(n - 1), np.arange(1, n)], 1)
+    L = dg.laplace.graph_laplacian(edges, np.ones(n - 1)).toarray()
+    f = np.arange(n) ** 2.0
+    assert np.allclose((L @ f)[1:-1], -2.0, atol=1e-14)
+
+
+# Smooth limits on regular planar triangulations of the unit square.
+
+
+def square_grid(n):
+    x, y = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
+    V = np.stack([x.ravel(), y.ravel(), 0 * x.ravel()], 1)
+    F = dg.mesh.triangulate(dg.mesh.builtin.grid_quads(n + 1, n + 1, False, False))
+    boundary = np.flatnonzero((x.ravel() % 1 == 0) | (y.ravel() % 1 == 0))
+    return V, F, boundary
+
+
+def laplacian_error(n):
+    """max over interior vertices of |−(L f)_i / M_i − Δf(x_i)|, f = sin(πx) cos(2y)."""
+    V, F, b = square_grid(n)
+    x, y = V[:, 0], V[:, 1]
+    f = np.sin(np.pi * x) * np.cos(2 * y)
+    lap = -(np.pi**2 + 4) * f
+    approx = -(dg.laplace.cotan_laplacian(V, F) @ f) / dg.laplace.barycentric_areas(V, F)
+    interior = np.setdiff1d(np.arange(len(V)), b)
+    return np.max(np.abs(approx - lap)[interior])
+
+
+def harmonic_error(n):
+    """max |f − u| for the dDBVP solution f with the boundary values of u = eˣ sin y."""
+    V, F, b = square_grid(n)
+    u = np.exp(V[:, 0]) * np.sin(V[:, 1])
+    f = dirichlet.cotan_sparse(V, F, b, u[b])
+    return np.max(np.abs(f - u))
+
+
+@pytest.mark.parametrize("error, label", [(laplacian_error, "|−Lf/M − Δf|∞"), (harmonic_error, "|f − u|∞")])
+def test_smooth_limit_order_two(error, label):
+    table = dg.limits.convergence(error, [8, 16, 32, 64], label=label)
+    print("\n" + table.to_markdown())
+    assert abs(table.fitted_order - 2.0) < 0.3
+
+
+# Bad input
+
+
+def test_bad_meshes_name_the_offender():
+    V, F = random_disk(6)
+    W = V.copy()
+    W[7, 1] = np.nan
+    with pytest.raises(NonFiniteError, match="vertex 7"):
+        dg.laplace.cotan_laplacian(W, F)
+    W = V.copy()
+    W[F[4, 2]] = 0.5 * (W[F[4, 0]] + W[F[4, 1]])  # collinear corners
+    with pytest.raises(DegenerateFaceError, match="face 4"):
+        dg.laplace.cotan_laplacian(W, F)
+    G = F.copy()
+    G[3, 1] = len(V) + 2
+    with pytest.raises(MeshError, match="face 3"):
+        dg.laplace.cotan_laplacian(V, G)
+    with pytest.raises(NonManifoldError):
+        bowtie = np.array([[0, 1, 2], [0, 3, 4]])
+        dirichlet.cotan(np.random.default_rng(0).normal(size=(5, 3)), bowtie, [1, 2, 3, 4], np.zeros(4))
+    with pytest.raises(InvalidInputError, match="edge 1"):
+        dg.laplace.graph_laplacian([[0, 1], [2, 2]], [1.0, 1.0])
+    assert not np.isnan(V).any()  # the caller's array is untouched
+
+
+def test_plots_are_written(tmp_path):
+    from ddgjax import plot_laplace
+
+    V, F, b = square_grid(8)
+    u = np.exp(V[:, 0]) * np.sin(V[:, 1])
+    f = dirichlet.cotan_sparse(V, F, b, u[b])
+    path = plot_laplace.harmonic_function(V, F, f, tmp_path / "harmonic.png")
+    assert path.exists() and path.stat().st_size > 5000
