@@ -16,6 +16,8 @@ from . import quaternion as quaternion  # noqa: E402
 from . import top as top  # noqa: E402
 from . import errors as errors  # noqa: E402
 from . import limits as limits  # noqa: E402
+from . import laplace as laplace  # noqa: E402
+from . import intrinsic as intrinsic  # noqa: E402
 from . import mesh as mesh  # noqa: E402
 from . import plot as plot  # noqa: E402
 from . import plot_surface as plot_surface  # noqa: E402

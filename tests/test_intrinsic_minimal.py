@@ -1,0 +1,109 @@
+"""Minimal surfaces in the narrow sense (Def 7.9, Fig 7.23, Remark 7.10) and the before/after
+flip plot."""
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay
+
+import ddgjax as dg
+from ddgjax.intrinsic import minimal
+from ddgjax.intrinsic import plot as iplot
+
+
+def _tall_dome(seed=0, n_inner=150, m=32, stretch=5.0, height=3.0):
+    """A start triangulation unsuited to the result (Fig 7.26): the planar Delaunay triangulation
+    of points in the unit disk squeezed by `stretch` in y (long skinny triangles), lifted to a
+    tall dome over the fixed boundary circle; the minimal surface is the flat disk."""
+    rng = np.random.default_rng(seed)
+    t = 2 * np.pi * np.arange(m) / m
+    r, a = np.sqrt(rng.uniform(0, 0.8, n_inner)), rng.uniform(0, 2 * np.pi, n_inner)
+    P = np.vstack([np.stack([np.cos(t), np.sin(t)], 1), np.stack([r * np.cos(a), r * np.sin(a)], 1)])
+    F = Delaunay(P * np.array([1.0, stretch])).simplices
+    u, w = P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]
+    clockwise = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0] < 0
+    F[clockwise] = F[clockwise][:, [0, 2, 1]]
+    V = np.column_stack([P, height * (1 - np.sum(P**2, axis=1))])
+    return V, F, np.arange(m)
+
+
+def _cotan_iteration(V, F, boundary, budget):
+    """Fig 6.5 (Pinkall–Polthier) by energies.area.minimal_surface(method="cotan"): True if it
+    converged within the budget; a degenerate iterate counts as not converged."""
+    area = pytest.importorskip("energies.area")
+    try:
+        _, _, info = area.minimal_surface(V, F, boundary, method="cotan", tol=1e-9, max_iter=budget, throw=False)
+    except dg.errors.DDGError:
+        return False
+    return info["converged"]
+
+
+def test_fig_6_5_cotan_iteration_here_agrees_with_energies_area():
+    """`harmonic_iteration(flip=False)` is Fig 6.5: the same iterates as energies.area."""
+    area = pytest.importorskip("energies.area")
+    V, F, boundary = _tall_dome(0, n_inner=40, m=16, stretch=1.0, height=0.5)
+    W1, _, info1 = minimal.harmonic_iteration(V, F, boundary, flip=False, max_iter=3)
+    W2, _, info2 = area.minimal_surface(V, F, boundary, method="cotan", max_iter=3, throw=False)
+    np.testing.assert_allclose(W1, W2, atol=1e-12)
+    np.testing.assert_allclose(info1["history"], info2["history"][: len(info1["history"])], rtol=1e-10, atol=1e-14)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_fig_7_26_cotan_iteration_fails_delaunay_iteration_converges(seed):
+    V, F, boundary = _tall_dome(seed)
+    assert not _cotan_iteration(V, F, boundary, budget=30)
+    W, F1, info = minimal.minimal_surface_delaunay(V, F, boundary, tol=1e-9, max_iter=30)
+    assert info["converged"] and info["iterations"] <= 5
+    assert info["flips"].sum() > 0  # the combinatorics changed
+    np.testing.assert_array_equal(F1, info["triangulation"].F)
+    # the same through the catalogue entry point
+    area = pytest.importorskip("energies.area")
+    W2, _, info2 = area.minimal_surface(V, F, boundary, method="delaunay", tol=1e-9, max_iter=30)
+    assert info2["converged"]
+    np.testing.assert_allclose(W2, W, atol=1e-12)
+    # Def 7.9: harmonic for the Laplace–Beltrami operator and Delaunay
+    tri = info["triangulation"]
+    assert dg.intrinsic.is_delaunay(tri)
+    L = dg.intrinsic.cotan_laplacian(tri)
+    free = np.ones(len(W), bool)
+    free[boundary] = False
+    assert abs((L @ W)[free]).max() < 1e-9
+    np.testing.assert_array_equal(W[boundary], V[boundary])
+    np.testing.assert_allclose(info["area"][-1], 0.5 * 32 * np.sin(2 * np.pi / 32), rtol=1e-9)  # the flat 32-gon
+
+
+def test_remark_7_10_maximum_principle_at_every_vertex():
+    """Every free vertex is a convex combination of its Delaunay neighbours (Prop 6.8): the
+    weights are ≥ 0 and reproduce the vertex."""
+    V, F, boundary = _tall_dome(2)
+    W, _, info = minimal.minimal_surface_delaunay(V, F, boundary)
+    tri = info["triangulation"]
+    L = dg.intrinsic.cotan_laplacian(tri).tocsr()
+    free = np.setdiff1d(np.arange(len(W)), boundary)
+    checked = 0
+    for i in free:
+        row = L.getrow(i)
+        j, w = row.indices[row.indices != i], -row.data[row.indices != i]
+        assert w.min() >= -1e-12 and w.sum() > 0
+        np.testing.assert_allclose(W[i], (w[:, None] * W[j]).sum(0) / w.sum(), atol=1e-9)
+        checked += 1
+    assert checked == len(free)
+
+
+def test_minimal_surface_bad_boundary_index():
+    V, F, _ = _tall_dome(0, n_inner=20, m=8)
+    with pytest.raises(dg.errors.MeshError, match="boundary vertex index 999"):
+        minimal.minimal_surface_delaunay(V, F, [0, 999])
+
+
+def test_plot_before_after_writes_png(tmp_path):
+    rng = np.random.default_rng(3)
+    P = rng.uniform(0, 1, (60, 2))
+    F = Delaunay(P * np.array([1.0, 6.0])).simplices  # not Delaunay for the true metric
+    u, w = P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]
+    cw = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0] < 0
+    F[cw] = F[cw][:, [0, 2, 1]]
+    path = tmp_path / "flips.png"
+    result = iplot.before_after(np.column_stack([P, np.zeros(60)]), F, path)
+    assert result.n_flips > 0 and dg.intrinsic.is_delaunay(result)
+    assert path.exists() and path.stat().st_size > 10_000
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
