@@ -1,10 +1,10 @@
-# Two commands on a fresh machine: `make demo` and `make test` (see README).
+# Two commands on a fresh machine: `make demo` (ddgjax verify --quick) and `make test` (see README).
 PYTHON ?= python3.11
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all bench clean
+.PHONY: demo examples test test-all bench clean
 
 $(STAMP): pyproject.toml
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "need $(PYTHON) on PATH (or make PYTHON=python3)"; exit 1; }
@@ -13,8 +13,12 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test]'
 	@touch $(STAMP)
 
+# the main job: every implemented statement of the reference, checked; report/report.md
 demo: $(STAMP)
-	$(PY) -m ddgjax.demo
+	$(VENV)/bin/ddgjax verify --quick --out report/
+
+examples: $(STAMP)
+	for script in examples/[!_]*.py; do echo "== $$script"; $(PY) $$script --out report/examples || exit 1; done
 
 test: $(STAMP)
 	$(PY) -m pytest -q
@@ -23,7 +27,7 @@ test-all: $(STAMP)
 	$(PY) -m pytest -q -m ''
 
 bench: $(STAMP)
-	for script in benchmarks/*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
+	$(VENV)/bin/ddgjax bench
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -208,7 +208,7 @@ def main() -> None:
         ):
             err = error_to(smooth, r["nodes"])
             rows.append(f"| {case} | {args.n} | {name} | {r['time']:.4g} | {r['compile']:.2f} | {err:.2e} | "
-                        f"{r['time'] / base:.0f}× | {detail} |")
+                        f"{ratio(r['time'] / base)} | {detail} |")
         shape_diff = float(np.max(np.linalg.norm(vertex["nodes"] - pe["nodes"], axis=1)))
         rows.append(f"| {case} | {args.n} | shape difference ddgjax (vertex) − PyElastica | | | {shape_diff:.2e} | | |")
         speedup = pe["time"] / base
@@ -224,6 +224,10 @@ def main() -> None:
     print("\n".join(rows))
     print("\nGoals (issue 4): ddgjax ≥ 50× faster than PyElastica at equal or better accuracy")
     print("\n".join(verdicts))
+
+
+def ratio(x: float) -> str:
+    return f"{x:.2g}×" if x < 10 else f"{x:.0f}×"
 
 
 def r_steps(r: dict) -> int:

@@ -46,6 +46,14 @@ def test_bad_input():
         rod.clamped(10, alpha=1.0, chord=[1.5, 0, 0], frame_start=START, frame_end=END)
     with pytest.raises(InvalidInputError):
         rod.clamped(10, alpha=1.0, chord=[0.6, 0, 0], frame_start=2 * START, frame_end=END)
+    with pytest.raises(InvalidInputError, match="NaN|finite"):
+        rod.clamped(10, alpha=1.0, chord=[0.6, 0, 0], frame_start=START * np.nan, frame_end=END)
+    with pytest.raises(InvalidInputError, match="clamp"):
+        rod.clamped(10, alpha=1.0, chord=[0.6, 0, 0], frame_start=START, frame_end=END, clamp="middle")
+    # end frames whose tangents disagree with the clamped tangents name the end
+    with pytest.raises(rod.ClampMismatchError, match="frame_end"):
+        rod.clamped(10, alpha=1.0, chord=[0.6, 0, 0], frame_start=START, frame_end=END, t_start=[0, 1, 0], t_end=[0, 1, 0])
+    rod.clamped(10, alpha=1.0, chord=[0.6, 0, 0], frame_start=START, frame_end=END, t_start=[0, 1, 0], t_end=[0, -1, 0])
 
 
 def test_uniform_helix_with_matching_end_frames_is_a_critical_point():

@@ -1,0 +1,288 @@
+"""The `ddgjax` command line: `verify`, `solve`, `bench`.
+
+    ddgjax verify [--quick] [--out DIR] [--only WORD ...] [--list] [--debug]
+    ddgjax solve elastica --n 100 --chord 0.5 0 0 --t-start 0 1 0 --t-end 0 -1 0 --plot out.png
+    ddgjax solve rod --n 60 --alpha 0.7 --chord 0.6 0 0 --twist 2.5 --plot rod.png
+    ddgjax solve minimal-surface --mesh annulus --height 0.4 --method cotan --plot surface.png
+    ddgjax bench [--quick] [NAME ...]
+
+Exit codes: 0 success, 1 a check failed (verify) or a benchmark script failed (bench), 2 bad
+input: a `DDGError` is printed as one line `ddgjax: error: … (hint: …)`, without a traceback
+unless `--debug`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from .errors import DDGError, InvalidInputError
+
+__all__ = ["main", "build_parser", "hint_for"]
+
+HINTS = {
+    "InfeasibleChordError": "choose a chord shorter than --length",
+    "ConvergenceError": "the problem may have no solution near the start: try a milder load (chord, twist, "
+                        "height), fewer unknowns first, or more --max-steps",
+    "NonFiniteError": "an input contains NaN or infinity",
+    "ShapeError": "vectors take three numbers, e.g. --chord 0.5 0 0",
+    "MeshError": "the mesh must be a valid surface (see `ddgjax.mesh.classify`)",
+    "NotAvailableError": "this object is still being implemented; see README for what exists",
+}
+
+
+class NotAvailableError(InvalidInputError):
+    """A command needs a part of the library that is not there yet."""
+
+
+def hint_for(error: DDGError) -> str:
+    """A short suggestion for the user, by the error's class (most specific first)."""
+    for cls in type(error).__mro__:
+        if cls.__name__ in HINTS:
+            return HINTS[cls.__name__]
+    return "check the arguments (`ddgjax <command> --help`), or rerun with --debug for the traceback"
+
+
+def _one_line(error: BaseException) -> str:
+    return " ".join(str(error).split()) or type(error).__name__
+
+
+# --- verify -----------------------------------------------------------------------------------
+
+
+def _verify(args) -> int:
+    from . import verify as v
+
+    if args.list:
+        v.load_checks()
+        for c in v.select(args.only):
+            print(f"{c.name:45s} {c.reference:25s} {c.statement}")
+        return 0
+    start = time.perf_counter()
+    outcomes, path = v.verify(args.out, quick=args.quick, only=args.only, progress=not args.no_progress, debug=args.debug,
+                              jobs=args.jobs)
+    failed = [o for o in outcomes if not o.passed]
+    ran = [o for o in outcomes if not o.skipped]
+    for o in failed:
+        why = o.error or f"value {o.value:.3g} does not meet {o.check.tolerance}"
+        print(f"FAIL {o.check.name} ({o.check.reference}): {why}", file=sys.stderr)
+    print(f"{len(ran) - len(failed)} of {len(ran)} checks passed in {time.perf_counter() - start:.0f} s"
+          + (f" ({len(outcomes) - len(ran)} run only without --quick)" if len(ran) < len(outcomes) else "")
+          + f"; report: {path}")
+    return 1 if failed else 0
+
+
+# --- solve ------------------------------------------------------------------------------------
+
+
+def _print_solution(sol, extra: dict) -> None:
+    print(f"energy        {float(sol.energy):.12g}")
+    for key, value in extra.items():
+        print(f"{key:13s} {value}")
+    print(f"KKT residual  {float(sol.residual):.2e} after {int(sol.steps)} Newton steps")
+
+
+def _solver_options(args) -> dict:
+    return {k: v for k, v in (("tol", args.tol), ("max_steps", args.max_steps)) if v is not None}
+
+
+def _solve_elastica(args) -> int:
+    import numpy as np
+
+    from energies import elastica
+    from solvers import solve
+
+    problem = elastica.clamped(args.n, length=args.length, chord=args.chord, t_start=args.t_start, t_end=args.t_end,
+                               clamp=args.clamp)
+    sol = solve(problem, **_solver_options(args))
+    gamma = np.asarray(elastica.curve(sol.x, problem))
+    a = np.asarray(elastica.theorem_3_8_a(sol, problem))
+    T = np.asarray(sol.x)
+    W = np.cross(T[1:], T[:-1]) / (1 + np.sum(T[1:] * T[:-1], axis=1))[:, None]
+    b = W - np.cross(a, gamma[1:-1])
+    _print_solution(sol, {"load λ": np.round(np.asarray(elastica.load(sol)), 8),
+                          "Thm 3.8": f"max_k |b_k − b_1| = {np.max(np.abs(b - b[0])):.1e}"})
+    if args.plot:
+        import ddgjax as dg
+
+        planar = np.allclose(gamma[:, 2], 0.0)
+        print("figure       ", dg.plot.curve(gamma[:, :2] if planar else gamma, path=args.plot))
+    return 0
+
+
+def _rotation_taking_e1_to(t):
+    """The unit quaternion of the smallest rotation taking e1 to the unit vector t."""
+    import numpy as np
+
+    from . import quaternion as qt
+
+    t = np.asarray(t, dtype=float)
+    if t.shape != (3,) or not np.linalg.norm(t) > 0:
+        raise InvalidInputError(f"a tangent must be a non-zero vector of three numbers, got {t}")
+    t = t / np.linalg.norm(t)
+    axis = np.cross([1.0, 0.0, 0.0], t)
+    if np.linalg.norm(axis) < 1e-12:
+        axis = np.array([0.0, 0.0, 1.0])
+    return qt.from_axis_angle(axis / np.linalg.norm(axis), float(np.arccos(np.clip(t[0], -1.0, 1.0))))
+
+
+def _solve_rod(args) -> int:
+    import numpy as np
+
+    from energies import rod
+    from solvers import solve
+
+    from . import quaternion as qt
+
+    start, end = _rotation_taking_e1_to(args.t_start), _rotation_taking_e1_to(args.t_end)
+    end = qt.mul(qt.from_axis_angle(qt.rotate(end, np.array([1.0, 0.0, 0.0])), args.twist), end)  # twist about T_end
+    problem = rod.clamped(args.n, alpha=args.alpha, length=args.length, chord=args.chord, frame_start=start, frame_end=end)
+    sol = solve(problem, **_solver_options(args))
+    theta = np.asarray(rod.twist_angles(sol.x))
+    _print_solution(sol, {"twist θ_k": f"{theta[0]:.8g} (spread {np.ptp(theta):.1e}, Lemma 3.12: constant)"})
+    if args.plot:
+        import ddgjax as dg
+
+        gamma = dg.curves.from_tangents(rod.tangents(sol.x), edge_length=args.length / args.n)
+        print("figure       ", dg.plot.curve(gamma, path=args.plot))
+    return 0
+
+
+def _solve_minimal_surface(args) -> int:
+    import numpy as np
+
+    from . import mesh
+
+    try:
+        from energies import area
+    except ImportError:
+        area = None
+    if area is None or not hasattr(area, "minimal_surface"):
+        raise NotAvailableError("minimal surfaces (energies.area.minimal_surface) are not available yet in this version")
+    if args.mesh in ("annulus", "disk"):
+        V, F = getattr(mesh, args.mesh)()
+        V = np.array(V)
+        if args.mesh == "annulus":  # lift the inner boundary circle: a catenoid-like neck
+            V[np.linalg.norm(V[:, :2], axis=1) < 0.75, 2] = args.height
+    else:
+        V, F = mesh.read(args.mesh)
+    boundary = np.unique(np.concatenate(mesh.boundary_loops(F)))
+    options = {k: v for k, v in (("tol", args.tol), ("max_iter", args.max_steps)) if v is not None}
+    V, F, info = area.minimal_surface(V, F, boundary, method=args.method, **options)
+    print(f"vertices      {len(V)}, faces {len(F)}")
+    print(f"area          {float(mesh.surface_area(V, F)):.12g}")
+    residual, iterations = info.get("residual", float("nan")), info.get("iterations", "?")
+    print(f"residual      {residual:.2e} after {iterations} iterations ({args.method})")
+    if args.plot:
+        from . import plot_surface
+
+        print("figure       ", plot_surface.surface(V, F, path=args.plot, color_by="mean_curvature"))
+    return 0
+
+
+SOLVERS = {"elastica": _solve_elastica, "rod": _solve_rod, "minimal-surface": _solve_minimal_surface}
+
+
+def _solve(args) -> int:
+    if args.plot:
+        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
+    return SOLVERS[args.object](args)
+
+
+# --- bench ------------------------------------------------------------------------------------
+
+
+def _benchmark_dir() -> Path:
+    """`benchmarks/` of the working directory, else of the source tree ddgjax was installed from."""
+    for candidate in (Path.cwd() / "benchmarks", Path(__file__).resolve().parent.parent / "benchmarks"):
+        if candidate.is_dir():
+            return candidate
+    raise NotAvailableError("no benchmarks/ directory here or next to the ddgjax sources; run from a clone of the repository")
+
+
+def _bench(args) -> int:
+    available = sorted(_benchmark_dir().glob("*.py"))
+    scripts = [s for s in available if not args.names or s.stem in args.names]
+    if not scripts:
+        raise InvalidInputError(f"no benchmark named {args.names}; have {[s.stem for s in available]}")
+    status = 0
+    for script in scripts:
+        quick = ["--quick"] if args.quick and "--quick" in script.read_text(encoding="utf-8") else []
+        print(f"== {script.name} {' '.join(quick)}".rstrip(), flush=True)
+        status |= subprocess.run([sys.executable, str(script), *quick], check=False).returncode != 0
+    return int(status)
+
+
+# --- parser -----------------------------------------------------------------------------------
+
+
+def _vector(name: str, default):
+    return dict(type=float, nargs=3, metavar=("X", "Y", "Z"), default=default, help=f"{name} (default: {default})")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="ddgjax", description="Variational discrete differential geometry in JAX.")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks instead of one-line errors")
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    verify = commands.add_parser("verify", help="check every implemented statement of the reference; write a report")
+    verify.add_argument("--quick", action="store_true", help="small sizes (under 2 minutes on 2 cores)")
+    verify.add_argument("--out", default="report", help="directory of report.md and figures/ (default: report)")
+    verify.add_argument("--only", nargs="+", metavar="WORD", help="run the checks whose name, reference or module contains WORD")
+    verify.add_argument("--list", action="store_true", help="list the checks and exit")
+    verify.add_argument("--no-progress", action="store_true", help="no progress bar")
+    verify.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
+                        help="worker processes (default: 2, or 1 on a single core)")
+    verify.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="stop at the first failing check with its traceback")
+    verify.set_defaults(run=_verify)
+
+    solve = commands.add_parser("solve", help="solve one object and print (and plot) it")
+    solve.add_argument("object", choices=sorted(SOLVERS))
+    solve.add_argument("--n", type=int, default=100, help="number of edges (default: 100)")
+    solve.add_argument("--length", type=float, default=1.0, help="length of the curve (default: 1)")
+    solve.add_argument("--chord", **_vector("end point minus start point", [0.5, 0.0, 0.0]))
+    solve.add_argument("--t-start", **_vector("tangent at the start", [0.0, 1.0, 0.0]))
+    solve.add_argument("--t-end", **_vector("tangent at the end", [0.0, -1.0, 0.0]))
+    solve.add_argument("--clamp", choices=["edge", "vertex"], default="edge", help="elastica: Def 3.2 (edge) or vertex tangents")
+    solve.add_argument("--alpha", type=float, default=0.7, help="rod: twist stiffness (default: 0.7)")
+    solve.add_argument("--twist", type=float, default=0.0, help="rod: extra twist of the end frame in radians")
+    solve.add_argument("--mesh", default="annulus", help="minimal-surface: annulus, disk, or a mesh file")
+    solve.add_argument("--height", type=float, default=0.4, help="minimal-surface: lift of the annulus' inner circle")
+    solve.add_argument("--method", choices=["cotan", "newton", "delaunay"], default="newton",
+                       help="minimal-surface: Fig 6.5 iteration (cotan), Newton on the area, or Fig 7.23 (delaunay)")
+    solve.add_argument("--max-steps", type=int, help="Newton steps / iterations (default: the solver's)")
+    solve.add_argument("--tol", type=float, help="tolerance on the residual (default: the solver's, 1e-10)")
+    solve.add_argument("--plot", metavar="PNG", help="save a figure there")
+    solve.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    solve.set_defaults(run=_solve)
+
+    bench = commands.add_parser("bench", help="run the benchmark scripts (benchmarks/*.py) and print their tables")
+    bench.add_argument("names", nargs="*", help="only these benchmarks (file names without .py)")
+    bench.add_argument("--quick", action="store_true", help="pass --quick to the scripts that accept it")
+    bench.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    bench.set_defaults(run=_bench)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (also used by the `ddgjax` entry point)."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except DDGError as error:
+        if args.debug:
+            raise
+        print(f"ddgjax: error: {_one_line(error)} (hint: {hint_for(error)})", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("ddgjax: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,172 @@
+"""Loading the check modules and running the registered checks, with a progress bar."""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+import sys
+import time
+from contextlib import contextmanager
+from pathlib import Path
+from queue import Empty
+from typing import Iterable
+
+from ..errors import InvalidInputError
+from ._registry import Check, Outcome, one_line, registry, run_check
+from ._report import write_report
+
+__all__ = ["load_checks", "select", "run", "verify"]
+
+_LOAD_ERRORS: dict[str, str] = {}
+
+
+def load_checks() -> dict[str, str]:
+    """Import every module of `ddgjax.verify.checks` (each registers its checks on import).
+
+    A module that fails to import is not fatal here: its error is returned (module → message)
+    and `verify` reports it as a failed check, so one broken module does not hide the others.
+    """
+    from . import checks
+
+    for info in sorted(pkgutil.iter_modules(checks.__path__), key=lambda i: i.name):
+        if info.name.startswith("_"):  # helpers shared by the check modules
+            continue
+        module = f"{checks.__name__}.{info.name}"
+        if module in _LOAD_ERRORS:
+            continue
+        try:
+            importlib.import_module(module)
+        except Exception as exc:
+            _LOAD_ERRORS[module] = one_line(exc)
+    return dict(_LOAD_ERRORS)
+
+
+def select(only: Iterable[str] | None = None) -> list[Check]:
+    """The registered checks in registration order, or those whose name, reference or module
+    contains one of the words in `only` (case-insensitive).
+
+    **Raises:** `InvalidInputError` if `only` matches no check.
+    """
+    checks = list(registry.values())
+    if not only:
+        return checks
+    words = [w.lower() for w in only]
+    chosen = [c for c in checks if any(w in f"{c.name} {c.reference} {c.fn.__module__}".lower() for w in words)]
+    if not chosen:
+        raise InvalidInputError(f"no check matches {list(only)}; `ddgjax verify --list` lists them")
+    return chosen
+
+
+@contextmanager
+def _progress(total: int, enabled: bool):
+    """A rich progress bar (on stderr) whose `advance(description)` moves it by one check."""
+    if not enabled:
+        yield lambda description: None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("[bold]verify"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+               TextColumn("{task.description}"))
+    with Progress(*columns, console=Console(stderr=True), transient=False) as bar:
+        task = bar.add_task("", total=total)
+        yield lambda description: bar.update(task, advance=1, description=description)
+
+
+def _status(outcome: Outcome) -> str:
+    state = "skipped" if outcome.skipped else "pass" if outcome.passed else "FAIL"
+    return f"{outcome.check.name}: {state} ({outcome.seconds:.1f} s)"
+
+
+def _group(c: Check) -> str:
+    """Checks of modules with the same `GROUP` share cached solutions: they run in one process."""
+    return getattr(sys.modules[c.fn.__module__], "GROUP", c.fn.__module__)
+
+
+def _run_names(modules: list[str], names: list[str], out: str, quick: bool, queue=None) -> list[dict]:
+    """Worker of the parallel run: import `modules`, run the checks `names`, return plain data."""
+    for module in modules:
+        importlib.import_module(module)
+    results = []
+    for name in names:
+        outcome = run_check(registry[name], Path(out), quick)
+        if queue is not None:
+            queue.put(_status(outcome))
+        results.append({k: getattr(outcome, k) for k in ("value", "passed", "seconds", "sizes", "figures", "tables",
+                                                         "error", "skipped")} | {"name": name})
+    return results
+
+
+def _run_parallel(checks: list[Check], out, quick: bool, jobs: int, advance) -> list[Outcome]:
+    """Run groups of checks in `jobs` spawned processes (JIT compilation is single-threaded, so
+    two cores compile two problems at once); returns outcomes in the order of `checks`."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    groups: dict[str, list[Check]] = {}
+    for c in checks:
+        groups.setdefault(_group(c), []).append(c)
+    tasks = sorted(groups.values(), key=len, reverse=True)
+    context = multiprocessing.get_context("spawn")
+    with context.Manager() as manager, ProcessPoolExecutor(jobs, mp_context=context) as pool:
+        queue = manager.Queue()
+        futures = [pool.submit(_run_names, sorted({c.fn.__module__ for c in task}), [c.name for c in task], str(out),
+                               quick, queue) for task in tasks]
+        while not all(f.done() for f in futures) or not queue.empty():
+            try:
+                advance(queue.get(timeout=0.5))
+            except Empty:
+                pass
+        results = {}
+        for task, future in zip(tasks, futures, strict=True):
+            for c, row in zip(task, _rows(task, future, quick), strict=True):
+                results[c.name] = row
+    return [Outcome(c, **{k: v for k, v in results[c.name].items() if k != "name"}) for c in checks]
+
+
+def _rows(task: list[Check], future, quick: bool) -> list[dict]:
+    """The worker's results, or one failed row per check if the worker itself failed."""
+    try:
+        return future.result()
+    except Exception as exc:  # e.g. a worker killed for memory: report, do not hang or crash
+        return [dict(name=c.name, value=float("nan"), passed=False, seconds=0.0, sizes=c.sizes(quick), figures=[],
+                     tables=[], error=f"worker failed: {one_line(exc)}", skipped=False) for c in task]
+
+
+def run(checks: list[Check], out, *, quick: bool, progress: bool = False, debug: bool = False,
+        jobs: int = 1) -> list[Outcome]:
+    """Run `checks` (in `jobs` processes when > 1; `debug` runs in this process and re-raises);
+    figures go under `out/figures`."""
+    with _progress(len(checks), progress) as advance:
+        if jobs > 1 and not debug and len(checks) > 1:
+            return _run_parallel(checks, out, quick, jobs, advance)
+        outcomes = []
+        for c in checks:
+            outcomes.append(run_check(c, Path(out), quick, debug))
+            advance(_status(outcomes[-1]))
+        return outcomes
+
+
+def _load_failure(module: str, message: str) -> Outcome:
+    pseudo = Check(name=module.rsplit(".", 1)[-1], reference="—", statement=f"module {module} imports",
+                   quantity="import", fn=lambda ctx: 0.0, quick={}, full={}, at_most=0.0, section="Modules that failed to load")
+    return Outcome(pseudo, float("nan"), False, 0.0, {}, [], [], message)
+
+
+def verify(out, *, quick: bool = False, only=None, progress: bool = False, debug: bool = False,
+           jobs: int = 1) -> tuple[list[Outcome], Path]:
+    """Load and run the checks (all, or those matching `only`) in `jobs` processes and write
+    `out/report.md`.
+
+    **Returns:** `(outcomes, report_path)`; every outcome's `passed` tells whether its statement
+    held within tolerance.  A check module that fails to import counts as a failed check.
+    """
+    start = time.perf_counter()
+    errors = load_checks()
+    if debug and errors:
+        raise ImportError(f"check modules failed to import: {errors}")
+    outcomes = run(select(only), out, quick=quick, progress=progress, debug=debug, jobs=jobs)
+    if not only:
+        outcomes += [_load_failure(m, msg) for m, msg in errors.items()]
+    path = write_report(outcomes, out, quick=quick, seconds=time.perf_counter() - start)
+    return outcomes, path

@@ -1,0 +1,209 @@
+"""Elastic curves: smooth and discrete elastica (Sec 3.1, 3.3)."""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+import ddgjax as dg
+from ddgjax import elastica_exact as exact
+from ddgjax.verify import check
+from energies import elastica
+from solvers import solve
+
+from ._shared import (
+    edge_midpoint_tangents,
+    euclidean_motion_residual,
+    planar_elastica,
+    smooth_clamped_elastica,
+    space_elastica,
+    thm_3_8_spread,
+)
+
+GROUP = "clamped elastica"  # share the solved elastica of _shared (one compilation per size)
+
+FAMILY_CHORDS = (0.8, 0.6, 0.4, 0.2)
+
+
+# --- the smooth oracle ------------------------------------------------------------------------
+
+
+def _second_derivative(f, s, h=2e-3):
+    """Fourth-order central difference: error ~h⁴|f⁽⁶⁾|/90 + 5δ/h², δ ≈ 1e-15 the accuracy of
+    scipy's Jacobi functions: observed ≤ 1e-7 here."""
+    return (-f(s + 2 * h) + 16 * f(s + h) - 30 * f(s) + 16 * f(s - h) - f(s - 2 * h)) / (12 * h**2)
+
+
+@check("Thm 3.1, 3.2", "the exact elliptic elastica solve T'' = cT + a and θ'' = −λ² sin(θ − θ_a)",
+       quantity="max |T'' − cT − a| + max |θ'' + λ² sin(θ − θ_a)| (finite differences)", at_most=1e-6,
+       quick=dict(samples=41))
+def exact_elastica_euler_lagrange(ctx, samples):
+    worst = 0.0
+    for curve in (exact.inflectional(0.7, lam=1.3, u0=0.4, length=5.0, load_angle=0.7),
+                  exact.non_inflectional(0.5, lam=1.2, u0=0.3, length=7.0, load_angle=1.0)):
+        s = np.linspace(0.1, curve.length - 0.1, samples)
+        T2 = _second_derivative(curve.tangent, s)
+        theta2 = _second_derivative(curve.tangent_angle, s)
+        tangent_eq = np.max(np.abs(T2 - curve.c(s)[:, None] * curve.tangent(s) - curve.a))
+        pendulum_eq = np.max(np.abs(theta2 + curve.lam**2 * np.sin(curve.tangent_angle(s) - curve.load_angle)))
+        worst = max(worst, float(tangent_eq + pendulum_eq))
+    return worst
+
+
+# --- Thm 3.8 and Cor 3.9 ----------------------------------------------------------------------
+
+
+def _thm_3_8_residual(problem, sol, sign=1.0) -> float:
+    gamma = np.asarray(elastica.curve(sol.x, problem))
+    return thm_3_8_spread(sol.x, gamma, sign * np.asarray(elastica.theorem_3_8_a(sol, problem)))
+
+
+def _register_thm_3_8(clamp: str) -> None:
+    def thm_3_8(ctx, n):
+        return _thm_3_8_residual(*space_elastica(n, clamp))
+
+    check("Thm 3.8", f"a clamped discrete space elastica (clamp={clamp}) satisfies "
+          "T_k × T_(k−1)/(1 + <T_k, T_(k−1)>) = a × γ_k + b with a = (h/2)·(chord multipliers)",
+          quantity="max_k |b_k − b_1|", at_most=1e-10, name=f"thm_3_8_{clamp}_clamp", quick=dict(n=32), full=dict(n=256))(thm_3_8)
+
+
+for _clamp in ("edge", "vertex"):
+    _register_thm_3_8(_clamp)
+
+
+@check("Thm 3.8", "negative control: with a replaced by −a the identity of Thm 3.8 fails",
+       quantity="max_k |b_k − b_1| with −a", at_least=1e-3, quick=dict(n=32), full=dict(n=256))
+def thm_3_8_wrong_sign_fails(ctx, n):
+    return _thm_3_8_residual(*space_elastica(n, "edge"), sign=-1.0)
+
+
+@check("Thm 3.8", "a family of planar elastica with decreasing chord: Thm 3.8 along the family",
+       quantity="max over the family of max_k |b_k − b_1|", at_most=1e-10, quick=dict(n=32), full=dict(n=200))
+def elastica_family(ctx, n):
+    solved = [planar_elastica(n, c) for c in FAMILY_CHORDS]
+    dg.plot.curves([np.asarray(elastica.curve(s.x, p))[:, :2] for p, s in solved], labels=[f"chord {c}" for c in FAMILY_CHORDS],
+                   path=ctx.figure("elastica_family.png"))
+    return max(_thm_3_8_residual(p, s) for p, s in solved)
+
+
+@check("Cor 3.9", "on an open discrete elastica the Heisenberg flow is an infinitesimal Euclidean motion a × γ + b",
+       quantity="least-squares residual max_k |w_k − a × γ_k − b|", at_most=1e-10, quick=dict(n=32), full=dict(n=256))
+def open_elastica_heisenberg_is_euclidean(ctx, n):
+    problem, sol = space_elastica(n, "edge")
+    gamma = np.asarray(elastica.curve(sol.x, problem))
+    w = np.asarray(dg.curves.heisenberg_flow(gamma, closed=False))[1:-1]
+    return euclidean_motion_residual(gamma[1:-1], w)
+
+
+# --- closed elastica: the regular polygon and Euler's figure-eight ----------------------------
+
+
+@functools.cache
+def figure_eight(n: int):
+    """The closed discrete elastica found from the tangents of the exact figure-eight (Remark 3.2)."""
+    eight = exact.figure_eight(lam=exact.figure_eight(lam=1.0).period)  # period 4K/λ = 1
+    problem = elastica.closed(n, x0=edge_midpoint_tangents(eight, n))
+    return problem, solve(problem), eight
+
+
+@check("Remark 3.2, 3.7", "a closed discrete elastica near Euler's figure-eight has its bending energy, to O(h²)",
+       quantity="n² |E_n − ½∫κ²| / ½∫κ²", at_most=20.0, quick=dict(n=48), full=dict(n=192))
+def figure_eight_energy(ctx, n):
+    problem, sol, eight = figure_eight(n)
+    gamma = np.asarray(elastica.curve(sol.x, problem))
+    dg.plot.curve(gamma[:, :2], path=ctx.figure("figure_eight.png"), color="k")
+    half = 0.5 * eight.bending_energy()
+    return n**2 * abs(float(sol.energy) - half) / half
+
+
+@check("Remark 3.7", "the figure-eight is a saddle: the Hessian of the Lagrangian on the constraints' tangent space "
+       "is indefinite",
+       quantity="smallest / largest |eigenvalue|", at_most=-1e-3, quick=dict(n=48), full=dict(n=96))
+def figure_eight_is_saddle(ctx, n):
+    problem, sol, _ = figure_eight(n)
+    x = jnp.ravel(sol.x)
+    lagrangian = lambda y: problem.energy(y.reshape(n, 3), problem.params) - sol.multipliers @ problem.constraints(  # noqa: E731
+        y.reshape(n, 3), problem.params)
+    H = np.asarray(jax.jit(jax.hessian(lagrangian))(x))
+    J = np.asarray(jax.jit(jax.jacobian(lambda y: problem.constraints(y.reshape(n, 3), problem.params)))(x))
+    Z = np.linalg.svd(J)[2][np.linalg.matrix_rank(J):].T
+    eig = np.linalg.eigvalsh(Z.T @ H @ Z)
+    return float(eig[0] / np.max(np.abs(eig)))
+
+
+def _procrustes(X, Y) -> float:
+    """max |R X_i + t − Y_i| over the best rotation R and translation t (Kabsch)."""
+    Xc, Yc = X - X.mean(0), Y - Y.mean(0)
+    U, _, Vt = np.linalg.svd(Xc.T @ Yc)
+    R = (U @ np.diag([1, 1, np.sign(np.linalg.det(U @ Vt))]) @ Vt).T
+    return float(np.max(np.abs(Xc @ R.T - Yc)))
+
+
+@check("Cor 3.9", "the Heisenberg flow moves the closed elastica (figure-eight) by Euclidean motions",
+       quantity="max distance to the best rigid image after t = 1", at_most=1e-8, quick=dict(n=48, steps=50),
+       full=dict(n=96, steps=200))
+def figure_eight_moves_rigidly(ctx, n, steps):
+    problem, sol, _ = figure_eight(n)
+    gamma = np.asarray(elastica.curve(sol.x, problem))[:-1]
+    _, path = dg.integrate(lambda g: dg.curves.heisenberg_flow(g, closed=True), jnp.asarray(gamma), 1.0, steps=steps)
+    return _procrustes(gamma, np.asarray(path[-1]))
+
+
+@check("Remark 3.7", "the regular n-gon is the closed elastica minimum with E = 2n² log(1 + tan²(π/n))",
+       quantity="|E − E_exact| / E_exact", at_most=1e-10, quick=dict(n=48), full=dict(n=96))
+def regular_polygon_energy(ctx, n):
+    k = np.arange(n)
+    rng = np.random.default_rng(0)
+    theta = 2 * np.pi * k / n + 0.05 * rng.normal(size=n)
+    T = np.stack([np.cos(theta), np.sin(theta), 0.05 * rng.normal(size=n)], axis=1)
+    sol = solve(elastica.closed(n, x0=T / np.linalg.norm(T, axis=1, keepdims=True)))
+    exact_energy = 2 * n * n * np.log1p(np.tan(np.pi / n) ** 2)
+    return abs(float(sol.energy) - exact_energy) / exact_energy
+
+
+# --- smooth limit -----------------------------------------------------------------------------
+
+
+@functools.cache
+def _limit_tables(clamp: str, ns: tuple):
+    """Max vertex distance to the exact clamped elastica and |λ − a| at each n (Newton started
+    from the exact tangents at the edge midpoints)."""
+    smooth = smooth_clamped_elastica()
+    data = smooth.boundary_data()
+    curve_errors, load_errors = [], []
+    for n in ns:
+        problem = elastica.clamped(n, chord=data.chord, t_start=data.start_tangent, t_end=data.end_tangent,
+                                   clamp=clamp, x0=edge_midpoint_tangents(smooth, n))
+        sol = solve(problem)
+        gamma = np.asarray(elastica.curve(sol.x, problem, start=data.start))
+        curve_errors.append(np.max(np.linalg.norm(gamma - smooth.gamma(np.arange(n + 1) / n), axis=1)))
+        load_errors.append(np.linalg.norm(np.asarray(elastica.load(sol)) - smooth.a))
+    return (dg.limits.ConvergenceTable.from_errors(ns, curve_errors, f"max_j dist(γ_j, γ(s_j)), clamp={clamp}"),
+            dg.limits.ConvergenceTable.from_errors(ns, load_errors, f"dist(λ, a), clamp={clamp}"))
+
+
+QUICK_NS, FULL_NS = (16, 32), (16, 32, 64, 128, 256, 512, 1024)  # quick: n = 32 is compiled for Thm 3.8
+
+
+@check("Thm 3.2, Def 3.2", "clamped discrete elastica (vertex clamp) converge to the exact elastica, order 2",
+       quantity="fitted order of max_j |γ_j − γ(s_j)|", target=2.0, within=0.2, quick=dict(ns=QUICK_NS), full=dict(ns=FULL_NS))
+def elastica_vertex_clamp_limit(ctx, ns):
+    curve_table, _ = _limit_tables("vertex", ns)
+    return ctx.convergence(curve_table, "convergence_elastica_vertex_clamp").fitted_order
+
+
+@check("Thm 3.2", "the chord multipliers λ converge to the smooth load a (vertex clamp), order 2",
+       quantity="fitted order of |λ − a|", target=2.0, within=0.2, quick=dict(ns=QUICK_NS), full=dict(ns=FULL_NS))
+def elastica_load_limit(ctx, ns):
+    _, load_table = _limit_tables("vertex", ns)
+    return ctx.convergence(load_table, "convergence_elastica_load").fitted_order
+
+
+@check("Def 3.2", "with Def 3.2's edge clamp (T_0 fixed at s = h/2) the limit is first order",
+       quantity="fitted order of max_j |γ_j − γ(s_j)|", target=1.0, within=0.2, quick=dict(ns=QUICK_NS), full=dict(ns=FULL_NS))
+def elastica_edge_clamp_limit(ctx, ns):
+    curve_table, _ = _limit_tables("edge", ns)
+    return ctx.convergence(curve_table, "convergence_elastica_edge_clamp").fitted_order

@@ -1,0 +1,106 @@
+"""The `ddgjax` command line: one-line errors with a hint and exit code 2, the verify report
+(table, convergence tables, figures present), a failing check gives a non-zero exit."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ddgjax import cli, verify
+from ddgjax.errors import InvalidInputError
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_bad_input_is_one_line_with_hint_and_exit_code_2():
+    """A real process: no traceback, one line on stderr, exit code 2."""
+    run = subprocess.run([sys.executable, "-m", "ddgjax", "solve", "elastica", "--n", "-3"], cwd=ROOT,
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in run.stderr
+    assert lines[0].startswith("ddgjax: error: ") and "n = -3" in lines[0] and "(hint: " in lines[0]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["solve", "elastica", "--chord", "1.5", "0", "0"], "not shorter than the length"),
+    (["solve", "elastica", "--n", "10", "--t-start", "0", "0", "0"], "t_start"),
+    (["solve", "rod", "--alpha", "-1"], "alpha must be positive"),
+    (["bench", "no-such-benchmark"], "no benchmark named"),
+    (["verify", "--only", "no-such-check"], "no check matches"),
+])
+def test_errors_in_process(argv, message, capsys):
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and message in err and "(hint: " in err
+
+
+def test_debug_shows_the_exception():
+    with pytest.raises(InvalidInputError, match="n = 2"):
+        cli.main(["--debug", "solve", "elastica", "--n", "2"])
+
+
+def test_solve_elastica_prints_and_plots(tmp_path, capsys):
+    assert cli.main(["solve", "elastica", "--n", "16", "--chord", "0.6", "0", "0", "--plot", str(tmp_path / "e.png")]) == 0
+    out = capsys.readouterr().out
+    residual = float(re.search(r"KKT residual\s+(\S+)", out).group(1))
+    assert residual <= 1e-10 and "Thm 3.8" in out
+    assert (tmp_path / "e.png").stat().st_size > 2000
+
+
+def _referenced_figures(report: Path) -> list[Path]:
+    return [report.parent / p for p in re.findall(r"!\[[^\]]*\]\(([^)]+)\)", report.read_text())]
+
+
+def test_verify_writes_the_report_with_existing_figures(tmp_path, capsys):
+    """Two processes (`--jobs 2`) over two modules' checks: the report has the table, every
+    check passes, every referenced figure exists."""
+    code = cli.main(["verify", "--quick", "--only", "sec4", "steiner", "mean_curvature", "--out", str(tmp_path),
+                     "--no-progress", "--jobs", "2"])
+    assert code == 0, capsys.readouterr()
+    report = tmp_path / "report.md"
+    text = report.read_text()
+    assert "| statement | reference | quantity | value | tolerance | result |" in text
+    assert "**FAIL**" not in text and "Thm 4.1" in text and "fitted order" in text
+    figures = _referenced_figures(report)
+    assert figures and all(p.is_file() and p.stat().st_size > 2000 for p in figures)
+
+
+def test_a_failing_check_gives_exit_code_1(tmp_path, capsys):
+    @verify.check("Test 0.0", "one plus one is three", quantity="|1 + 1 − 3|", at_most=1e-12, name="deliberately_false")
+    def deliberately_false(ctx):
+        return abs(1 + 1 - 3)
+
+    try:
+        assert cli.main(["verify", "--only", "deliberately_false", "--out", str(tmp_path), "--no-progress"]) == 1
+    finally:
+        del verify.registry["deliberately_false"]
+    assert "FAIL deliberately_false" in capsys.readouterr().err
+    assert "**FAIL**" in (tmp_path / "report.md").read_text()
+
+
+def test_check_tolerances_and_registration_errors():
+    verify.load_checks()
+    c = verify.registry["total_mean_curvature_limit"]
+    assert c.passes(2.05) and not c.passes(2.2) and not c.passes(float("nan")) and c.tolerance == "2 ± 0.1"
+    with pytest.raises(InvalidInputError, match="exactly one"):
+        verify.check("Def 0", "nothing", quantity="x", at_most=1.0, at_least=0.0)
+
+
+def test_verify_list(capsys):
+    assert cli.main(["verify", "--list", "--only", "Thm 5.6"]) == 0
+    assert "gauss_bonnet_builtin" in capsys.readouterr().out
+
+
+def test_entry_point_is_declared():
+    assert 'ddgjax = "ddgjax.cli:main"' in (ROOT / "pyproject.toml").read_text()
+
+
+@pytest.mark.slow
+def test_quick_verify_passes_every_check(tmp_path):
+    """The acceptance run of `make demo`: every check passes, every referenced figure exists."""
+    outcomes, report = verify.verify(tmp_path, quick=True, jobs=2)
+    assert [o.check.name for o in outcomes if not o.passed] == []
+    assert all(p.is_file() for p in _referenced_figures(report))
