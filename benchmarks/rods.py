@@ -98,17 +98,6 @@ def run_ddgjax(n: int, alpha: float, twist: float, clamp: str, repeats: int):
             "steps": int(sol.steps), "problem": problem, "solution": sol}
 
 
-def smooth_reference(alpha: float, twist: float, guess: dict):
-    """The smooth clamped rod by shooting, started from a discrete vertex-clamped solution."""
-    q0, q1 = end_frames(twist)
-    problem, sol = guess["problem"], guess["solution"]
-    Omega = 4 * qt.log(qt.mul(qt.conj(q0), sol.x[0])) / problem.params["h"]
-    return kirchhoff.clamped_rod(
-        alpha=alpha, chord=CHORD, frame_start=q0, frame_end=q1,
-        M0_guess=2 * jnp.array([alpha, 1.0, 1.0]) * Omega, a_guess=rod.load(sol),
-    )
-
-
 def import_pyelastica():
     """PyElastica's `elastica`, not this folder's benchmarks/elastica.py (the script's folder
     comes first on sys.path)."""
@@ -193,7 +182,8 @@ def main() -> None:
         progress(f"{case}: ddgjax ...")
         vertex = run_ddgjax(args.n, args.alpha, twist, "vertex", args.repeats)
         edge = run_ddgjax(args.n, args.alpha, twist, "edge", args.repeats)
-        smooth = smooth_reference(args.alpha, twist, run_ddgjax(REFERENCE_GUESS_N, args.alpha, twist, "vertex", 0))
+        guess = run_ddgjax(REFERENCE_GUESS_N, args.alpha, twist, "vertex", 0)
+        smooth = kirchhoff.from_discrete(guess["problem"], guess["solution"])
         progress(f"{case}: PyElastica ...")
         runs = [run_pyelastica(args.n, args.alpha, twist, args.speed_tol, args.max_time)
                 for _ in range(args.pyelastica_repeats)]

@@ -32,10 +32,12 @@ import optimistix as optx
 from jaxtyping import Array, Float
 
 from . import quaternion as qt
+from .curves import from_tangents
 from .errors import ConvergenceError, InvalidInputError
+from .frames import edge_frame_split
 from .top import TopState, equations_of_motion
 
-__all__ = ["SmoothRod", "shoot", "clamped_rod", "sample", "torsion", "discrete_top_residual"]
+__all__ = ["SmoothRod", "shoot", "clamped_rod", "from_discrete", "discrete_errors", "sample", "torsion", "discrete_top_residual"]
 
 E1 = jnp.array([1.0, 0.0, 0.0])
 RTOL = 1e-13
@@ -116,6 +118,34 @@ def clamped_rod(
             residual=residual, steps=int(sol.stats["num_steps"]), solution=sol.value,
         )
     return SmoothRod(Phi0, sol.value[:3], sol.value[3:], float(alpha), float(length))
+
+
+def from_discrete(problem, solution, *, tol: float = 1e-11) -> SmoothRod:
+    """The smooth clamped rod with the clamps, chord and α of a solved *vertex-clamped* discrete
+    rod (`energies.rod.clamped(..., clamp="vertex")`), by shooting from its guess: the body
+    angular velocity at s = 0, `Ω(0) ≈ 4 log(q0⁻¹ Φ_0)/h` (Φ_0 is the frame at s = h/2), gives
+    `M0 = 2JΩ(0)`, and the chord multipliers give `a` (`energies.rod.load`)."""
+    p = problem.params
+    q0, h, alpha = p["frame_start"], p["h"], float(p["alpha"])
+    Omega = 4 * qt.log(qt.mul(qt.conj(q0), solution.x[0])) / h
+    return clamped_rod(
+        alpha=alpha, length=h * solution.x.shape[0], chord=p["chord"], frame_start=q0, frame_end=p["frame_end"],
+        M0_guess=2 * jnp.array([alpha, 1.0, 1.0]) * Omega, a_guess=solution.multipliers[-3:], tol=tol,
+    )
+
+
+def discrete_errors(problem, solution, smooth: SmoothRod) -> dict[str, float]:
+    """Distances of a solved discrete rod to the smooth rod: `position` max_k |γ_k − γ(kh)| over
+    the vertices (γ_0 = 0), `load` max |λ − a|, `twist` |mean θ_k / h − τ|."""
+    Phi, h = jnp.asarray(solution.x), problem.params["h"]
+    n = Phi.shape[0]
+    _, gamma = sample(smooth, np.arange(n + 1) * h)
+    nodes = from_tangents(qt._rotate(Phi, E1), edge_length=h)
+    return {
+        "position": float(jnp.max(jnp.linalg.norm(nodes - gamma, axis=1))),
+        "load": float(jnp.max(jnp.abs(solution.multipliers[-3:] - smooth.a))),
+        "twist": abs(float(jnp.mean(edge_frame_split(Phi)[1])) / h - torsion(smooth)),
+    }
 
 
 def sample(rod: SmoothRod, s) -> tuple[Float[Array, "m 4"], Float[Array, "m 3"]]:

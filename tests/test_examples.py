@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
-FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", "pendulum_shooting"]
+FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", "pendulum_shooting", "catenoid",
+        "intrinsic_delaunay", "narrow_minimal_surface"]
 # the rod's KKT system takes minutes to compile on 2 cores: run with `make test-all`
 SLOW = ["twisted_rod"]
 

@@ -35,24 +35,8 @@ def rods():
 
 @pytest.fixture(scope="module")
 def smooth(rods):
-    """The smooth rod by shooting, started from the n = 32 discrete rod: M0 = 2JΩ(0) with the
-    body angular velocity Ω(0) ≈ 4 log(q0⁻¹ Φ_0)/h (Φ_0 is the frame at s = h/2), a = λ."""
-    problem, sol = rods[32]
-    Omega = 4 * qt.log(qt.mul(qt.conj(START), sol.x[0])) / problem.params["h"]
-    return kirchhoff.clamped_rod(
-        alpha=ALPHA, chord=CHORD, frame_start=START, frame_end=END,
-        M0_guess=2 * jnp.array([ALPHA, 1.0, 1.0]) * Omega, a_guess=rod.load(sol),
-    )
-
-
-def _errors(problem, sol, smooth):
-    """Max distance of the discrete vertices γ_k to γ(kh), load error |λ − a|, twist rate error."""
-    n, h = sol.x.shape[0], problem.params["h"]
-    _, gamma = kirchhoff.sample(smooth, np.arange(n + 1) * h)
-    position = float(jnp.max(jnp.linalg.norm(rod.curve(sol.x, problem) - gamma, axis=1)))
-    load = float(jnp.max(jnp.abs(rod.load(sol) - smooth.a)))
-    twist = abs(float(jnp.mean(rod.twist_angles(sol.x))) / h - kirchhoff.torsion(smooth))
-    return position, load, twist
+    """The smooth rod by shooting, started from the n = 32 discrete rod."""
+    return kirchhoff.from_discrete(*rods[32])
 
 
 def test_shooting_reference_meets_the_clamps(smooth):
@@ -65,7 +49,7 @@ def test_shooting_reference_meets_the_clamps(smooth):
 def test_vertex_clamped_discrete_rods_converge_at_order_two(rods, smooth):
     """Thm 3.13: centreline, load a and torsion τ of the discrete rods converge at O(h²)."""
     ns = sorted(rods)
-    errors = np.array([_errors(*rods[n], smooth) for n in ns])
+    errors = np.array([list(kirchhoff.discrete_errors(*rods[n], smooth).values()) for n in ns])
     for column, name in enumerate(["position", "load", "twist"]):
         table = dg.limits.convergence(lambda n, c=column: errors[ns.index(n), c], ns)
         assert abs(table.fitted_order - 2.0) <= 0.3, (name, table.to_markdown())
@@ -94,6 +78,6 @@ def test_smooth_limit_tables_edge_and_vertex_clamps(smooth):
     """The full study: vertex clamps O(h²), edge clamps (frames at s = h/2, L − h/2) only O(h)."""
     ns = [16, 32, 64, 128, 256]
     for clamp, order in (("vertex", 2.0), ("edge", 1.0)):
-        table = dg.limits.convergence(lambda n: _errors(*_discrete(n, clamp), smooth)[0], ns)
+        table = dg.limits.convergence(lambda n: kirchhoff.discrete_errors(*_discrete(n, clamp), smooth)["position"], ns)
         print(clamp, table.to_markdown())
         assert abs(table.fitted_order - order) <= 0.3, table.to_markdown()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import importlib
 import pkgutil
 import sys
@@ -107,6 +109,10 @@ def _run_parallel(checks: list[Check], out, quick: bool, jobs: int, advance) -> 
     for c in checks:
         groups.setdefault(_group(c), []).append(c)
     tasks = sorted(groups.values(), key=len, reverse=True)
+    # The checks solve small problems once each: XLA's compile time, not their run time, is
+    # most of a run, and LLVM's backend optimisation off halves it.  Spawned workers start a
+    # fresh JAX backend, so the setting applies there (unless XLA_FLAGS is set already).
+    os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
     context = multiprocessing.get_context("spawn")
     with context.Manager() as manager, ProcessPoolExecutor(jobs, mp_context=context) as pool:
         queue = manager.Queue()

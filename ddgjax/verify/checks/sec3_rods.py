@@ -1,4 +1,4 @@
-"""Discrete elastic rods (Sec 3.5, 3.6: Def 3.6, 3.7, Lemma 3.12)."""
+"""Discrete elastic rods (Sec 3.5, 3.6: Def 3.6, 3.7, Lemma 3.12, Thm 3.11, 3.13)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import ddgjax as dg
+from ddgjax import kirchhoff
 from ddgjax import quaternion as qt
 from ddgjax.verify import check
 from energies import rod
@@ -57,3 +58,39 @@ def rod_combined_flow_is_euclidean(ctx, n):
     w = np.asarray(dg.curves.heisenberg_flow(gamma, closed=False))[1:-1]
     v = np.asarray(dg.curves.tangent_flow(gamma, closed=False))[1:-1]
     return euclidean_motion_residual(gamma[1:-1], w, extra=v) / float(np.max(np.abs(w)))
+
+
+@functools.cache
+def vertex_clamped_rods(ns: tuple[int, ...]):
+    """Twisted 3D rods with second-order (vertex) clamps and the smooth rod by shooting."""
+    e1 = jnp.array([1.0, 0.0, 0.0])
+    end = qt.mul(qt.from_axis_angle(E3, 2.0), qt.from_axis_angle(e1, 1.5))
+    rods = {}
+    for n in ns:
+        problem = rod.clamped(n, alpha=0.6, chord=[0.5, 0.3, 0.15], frame_start=[1.0, 0, 0, 0], frame_end=end,
+                              clamp="vertex")
+        rods[n] = (problem, solve(problem))
+    return rods, kirchhoff.from_discrete(*rods[ns[len(ns) // 2]])
+
+
+@check("Thm 3.13", "discrete rods (vertex clamps) converge to the smooth rod computed by shooting with the Lagrange top",
+       quantity="fitted order of max_k |γ_k − γ(kh)|", target=2.0, within=0.3,
+       quick=dict(ns=(16, 32, 64)), full=dict(ns=(16, 32, 64, 128, 256)), full_only=True)
+def rod_smooth_limit(ctx, ns):
+    rods, smooth = vertex_clamped_rods(ns)
+    table = dg.limits.convergence(lambda n: kirchhoff.discrete_errors(*rods[n], smooth)["position"], list(ns))
+    return ctx.convergence(table, "convergence_rod_centreline").fitted_order
+
+
+@check("Thm 3.11", "a solved rod's tangent and angular velocity solve the Lagrange top equations with its a and α",
+       quantity="fitted order of the top-equation residual", target=2.0, within=0.3,
+       quick=dict(ns=(16, 32, 64)), full=dict(ns=(16, 32, 64, 128, 256)), full_only=True)
+def rod_is_a_top_motion(ctx, ns):
+    rods, _ = vertex_clamped_rods(ns)
+
+    def residual(n):
+        problem, sol = rods[n]
+        r = kirchhoff.discrete_top_residual(sol.x, problem.params["h"], 0.6, rod.load(sol))
+        return float(jnp.max(jnp.abs(r)))
+
+    return ctx.convergence(dg.limits.convergence(residual, list(ns)), "convergence_rod_top_residual").fitted_order
