@@ -8,22 +8,7 @@ from scipy.spatial import Delaunay
 import ddgjax as dg
 from ddgjax.intrinsic import minimal
 from ddgjax.intrinsic import plot as iplot
-
-
-def _tall_dome(seed=0, n_inner=150, m=32, stretch=5.0, height=3.0):
-    """A start triangulation unsuited to the result (Fig 7.26): the planar Delaunay triangulation
-    of points in the unit disk squeezed by `stretch` in y (long skinny triangles), lifted to a
-    tall dome over the fixed boundary circle; the minimal surface is the flat disk."""
-    rng = np.random.default_rng(seed)
-    t = 2 * np.pi * np.arange(m) / m
-    r, a = np.sqrt(rng.uniform(0, 0.8, n_inner)), rng.uniform(0, 2 * np.pi, n_inner)
-    P = np.vstack([np.stack([np.cos(t), np.sin(t)], 1), np.stack([r * np.cos(a), r * np.sin(a)], 1)])
-    F = Delaunay(P * np.array([1.0, stretch])).simplices
-    u, w = P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]
-    clockwise = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0] < 0
-    F[clockwise] = F[clockwise][:, [0, 2, 1]]
-    V = np.column_stack([P, height * (1 - np.sum(P**2, axis=1))])
-    return V, F, np.arange(m)
+from ddgjax.verify.checks._surfaces import tall_dome as _tall_dome  # Fig 7.26's start
 
 
 def _cotan_iteration(V, F, boundary, budget):
