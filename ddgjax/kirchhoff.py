@@ -23,9 +23,11 @@ also selects the branch when the clamped problem has several solutions).
 
 from __future__ import annotations
 
+from functools import partial
 from typing import NamedTuple
 
 import diffrax
+import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
@@ -37,7 +39,10 @@ from .errors import ConvergenceError, InvalidInputError
 from .frames import edge_frame_split
 from .top import TopState, equations_of_motion
 
-__all__ = ["SmoothRod", "shoot", "clamped_rod", "from_discrete", "discrete_errors", "sample", "torsion", "discrete_top_residual"]
+__all__ = [
+    "SmoothRod", "shoot", "clamped_rod", "from_discrete", "discrete_errors", "sample", "torsion",
+    "discrete_top_residual",
+]
 
 E1 = jnp.array([1.0, 0.0, 0.0])
 RTOL = 1e-13
@@ -80,10 +85,31 @@ def _integrate(Phi0, M0, a, alpha, length, ts):
     return sol.ys
 
 
+_sample = jax.jit(_integrate)
+
+
 def shoot(z: Float[Array, "6"], Phi0, Phi1, chord, alpha, length) -> Float[Array, "6"]:
     """The shooting residual of z = (M0, a): `(Im(Φ1⁻¹ Φ(L)), γ(L) − chord)`."""
     Phi, _M, gamma = _integrate(Phi0, z[:3], z[3:], alpha, length, jnp.array([length]))
     return jnp.concatenate([qt._mul(qt._conj(Phi1), Phi[0])[1:], gamma[0] - chord])
+
+
+_shoot = jax.jit(shoot)
+
+
+def _residual(z, args):
+    return shoot(z, *args)
+
+
+@partial(jax.jit, static_argnames="tol")
+def _least_squares(z0, args, *, tol: float):
+    """Levenberg–Marquardt on |shoot|² (compiled once per process: module-level functions).
+    Near a buckling load the shooting Jacobian is nearly singular and undamped Newton leaves the
+    branch of the guess."""
+    sol = optx.least_squares(
+        _residual, optx.LevenbergMarquardt(rtol=tol, atol=tol), z0, args=args, throw=False, max_steps=200
+    )
+    return sol.value, sol.stats["num_steps"]
 
 
 def clamped_rod(
@@ -102,22 +128,17 @@ def clamped_rod(
     qt.check_unit(frame_end, "frame_end")
     Phi0, Phi1 = jnp.asarray(frame_start, dtype=float), jnp.asarray(frame_end, dtype=float)
     chord = jnp.asarray(chord, dtype=float)
-    args = (Phi0, Phi1, chord, float(alpha), float(length))
+    args = (Phi0, Phi1, chord, jnp.asarray(float(alpha)), jnp.asarray(float(length)))
     z0 = jnp.concatenate([jnp.asarray(M0_guess, dtype=float), jnp.asarray(a_guess, dtype=float)])
-    # Levenberg–Marquardt on |shoot|²: near a buckling load the shooting Jacobian is nearly
-    # singular and undamped Newton leaves the branch of the guess
-    sol = optx.least_squares(
-        lambda z, args: shoot(z, *args), optx.LevenbergMarquardt(rtol=tol, atol=tol), z0, args=args,
-        throw=False, max_steps=200,
-    )
-    residual = float(jnp.max(jnp.abs(shoot(sol.value, *args))))
+    value, steps = _least_squares(z0, args, tol=float(tol))
+    residual = float(jnp.max(jnp.abs(_shoot(value, *args))))
     if not residual <= 10 * tol:
         raise ConvergenceError(
             f"shooting for the smooth rod did not converge: residual {residual:.3e} > {tol:.1e} "
             "(try a better guess, e.g. from a finer discrete rod)",
-            residual=residual, steps=int(sol.stats["num_steps"]), solution=sol.value,
+            residual=residual, steps=int(steps), solution=value,
         )
-    return SmoothRod(Phi0, sol.value[:3], sol.value[3:], float(alpha), float(length))
+    return SmoothRod(Phi0, value[:3], value[3:], float(alpha), float(length))
 
 
 def from_discrete(problem, solution, *, tol: float = 1e-11) -> SmoothRod:
@@ -150,7 +171,8 @@ def discrete_errors(problem, solution, smooth: SmoothRod) -> dict[str, float]:
 
 def sample(rod: SmoothRod, s) -> tuple[Float[Array, "m 4"], Float[Array, "m 3"]]:
     """The frames Φ(s) and the centreline γ(s) (γ(0) = 0) at the arc lengths s (m,)."""
-    Phi, _M, gamma = _integrate(rod.Phi0, rod.M0, rod.a, rod.alpha, rod.length, jnp.asarray(s, dtype=float))
+    Phi, _M, gamma = _sample(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length),
+                             jnp.asarray(s, dtype=float))
     return Phi, gamma
 
 

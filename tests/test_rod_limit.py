@@ -30,7 +30,7 @@ def _discrete(n, clamp="vertex"):
 
 @pytest.fixture(scope="module")
 def rods():
-    return {n: _discrete(n) for n in (16, 32, 64)}
+    return {n: _discrete(n) for n in (16, 32)}  # two compilations; the slow study goes to n = 256
 
 
 @pytest.fixture(scope="module")
@@ -47,13 +47,14 @@ def test_shooting_reference_meets_the_clamps(smooth):
 
 
 def test_vertex_clamped_discrete_rods_converge_at_order_two(rods, smooth):
-    """Thm 3.13: centreline, load a and torsion τ of the discrete rods converge at O(h²)."""
+    """Thm 3.13: centreline, load a and torsion τ of the discrete rods converge at O(h²)
+    (n = 16, 32 here; n = 16 … 256 in the slow study)."""
     ns = sorted(rods)
     errors = np.array([list(kirchhoff.discrete_errors(*rods[n], smooth).values()) for n in ns])
     for column, name in enumerate(["position", "load", "twist"]):
         table = dg.limits.convergence(lambda n, c=column: errors[ns.index(n), c], ns)
         assert abs(table.fitted_order - 2.0) <= 0.3, (name, table.to_markdown())
-    assert errors[-1, 0] <= 1e-4
+    assert errors[-1, 0] <= 1e-3
 
 
 def test_kirchhoff_analogy_discrete_rod_is_a_top_motion(rods):
@@ -68,9 +69,9 @@ def test_kirchhoff_analogy_discrete_rod_is_a_top_motion(rods):
         table = dg.limits.convergence(lambda n, r=row: residuals[n][r], ns)
         assert abs(table.fitted_order - 2.0) <= 0.3, table.to_markdown()
     # with a wrong load the residual does not vanish: the check can fail
-    p, sol = rods[64]
+    p, sol = rods[32]
     wrong = np.abs(np.asarray(kirchhoff.discrete_top_residual(sol.x, p.params["h"], ALPHA, -rod.load(sol)))).max()
-    assert wrong > 100 * residuals[64].max()
+    assert wrong > 100 * residuals[32].max()
 
 
 @pytest.mark.slow
