@@ -2,11 +2,13 @@
 
 `solve(problem)` runs globalised Newton on the KKT system of a `ddgjax.Problem` with dense or
 sparse (declared locality) linear algebra, an optional first-order phase, and implicit
-differentiation.  This package knows nothing of curves or meshes.
+differentiation; `solve_batch(problem, params_batch, devices=...)` solves a batch of
+parameters in one call, vectorised and sharded over devices.  This package knows nothing of curves or meshes.
 """
 
 import ddgjax as _ddgjax  # noqa: F401  (switches on float64 before anything is traced)
 
 from ._solve import Solution as Solution, solve as solve
+from ._batch import solve_batch as solve_batch
 
-__all__ = ["solve", "Solution"]
+__all__ = ["solve", "solve_batch", "Solution"]

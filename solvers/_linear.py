@@ -19,7 +19,8 @@ graph, and the per-cell Hessians are its largest part.
 The sparse back end's index arrays enter the compiled solver as constants (it is a static
 argument of `jit`): XLA's gathers and scatters with constant indices are ~10× faster than
 with traced ones.
-- `DenseAlgebra`: `K` by forward-over-reverse autodiff, LU through lineax.  For n ≲ 2,000.
+- `DenseAlgebra`: `K` by forward-over-reverse autodiff, LU by `jax.scipy.linalg.lu_factor` (not
+  lineax's LU, whose structure check fails inside `jax.shard_map`: `solve_batch`).  For n ≲ 2,000.
 - `SparseAlgebra`: `K` assembled from the per-cell Hessian blocks of a problem declared with
   `dg.local_sum` / `dg.local_map`, factorised by KLU (klujax), inside `jit`, `vmap`-able.
   Its LM step solves the augmented system `[[I, K], [Kᵀ, −ν I]] (s, d) = (−R, 0)`, which
@@ -33,7 +34,6 @@ from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
-import lineax as lx
 
 from ._kkt import KKT
 from ._sparse import SparsePattern, cell_blocks
@@ -65,13 +65,13 @@ class DenseAlgebra:
     def factor_matrix(self, kkt: KKT, K, mu_rel):
         scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
         K = K + jnp.diag(_regularisation(kkt.spec.n, kkt.spec.m, jnp.maximum(mu_rel * scale, MU_FLOOR)))
-        return _LU.init(lx.MatrixLinearOperator(K), {})
+        return jax.scipy.linalg.lu_factor(K)
 
     def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
         return self.factor_matrix(kkt, self.matrix(kkt, w, identity_hessian), mu_rel)
 
     def apply(self, fac, b):
-        return _LU.compute(fac, b, {})[0]
+        return jax.scipy.linalg.lu_solve(fac, b)
 
     def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
         return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
@@ -81,10 +81,8 @@ class DenseAlgebra:
 
     def lm_solve_matrix(self, K, nu, R):
         normal = K.T @ K + nu * jnp.eye(K.shape[0])
-        return self.apply(_LU.init(lx.MatrixLinearOperator(normal), {}), -K.T @ R)
+        return self.apply(jax.scipy.linalg.lu_factor(normal), -K.T @ R)
 
-
-_LU = lx.LU()
 
 
 def _klu_solve(rows, cols, values, b, symbolic):
@@ -144,7 +142,8 @@ class SparseAlgebra:
         n, m, p = kkt.spec.n, kkt.spec.m, self.pattern
         hess, jac = cell_blocks(p, kkt, w, identity_hessian)
         raw = jnp.concatenate([hess, -jac])
-        diag = jnp.zeros((n + m,)).at[:n].add(1.0 if identity_hessian else 0.0)
+        # a concatenation, not `zeros.at[:n].add`: XLA constant-folds that scatter (seconds at 10⁵)
+        diag = jnp.concatenate([jnp.full((n,), 1.0 if identity_hessian else 0.0), jnp.zeros((m,))])
         values = jnp.concatenate([raw[p.source], diag])
         return jax.ops.segment_sum(values, p.target, num_segments=p.nnz)
 

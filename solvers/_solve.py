@@ -125,7 +125,8 @@ def solve(
 
     **Returns:** a `Solution`. `jax.grad`/`jax.jacobian` of functions of `.x`, `.multipliers`,
     `.energy` with respect to `problem.params` (and `x0`'s fixed entries) are exact (implicit
-    function theorem), and `jax.vmap` over `params` works.
+    function theorem), and `jax.vmap` over `params` works (also under `jit`, on both the dense and
+    the sparse path; `solve_batch` packages it and shards a batch over devices).
 
     **Raises:** `ConvergenceError` (with `.residual`, `.steps`, `.solution`), `NonFiniteError`
     when the energy or residual is NaN at `x0`, `InvalidInputError` for unknown options.

@@ -22,6 +22,15 @@ from ddgjax.locality import Local, Term
 from ._kkt import KKT, Spec
 
 
+def _analyze(rows: np.ndarray, cols: np.ndarray, size: int):
+    """`klujax.analyze`, run now even when called under an outer `jit` (e.g. `jit(vmap(solve))`),
+    where it would otherwise return a tracer instead of the KLU symbolic object."""
+    import klujax
+
+    with jax.ensure_compile_time_eval():
+        return klujax.analyze(jnp.asarray(rows), jnp.asarray(cols), size)
+
+
 @dataclass(frozen=True, eq=False)
 class TermPattern:
     term: Term
@@ -67,13 +76,11 @@ class SparsePattern:
         Made outside any trace and kept alive by this pattern, which `jit`'s cache holds
         through the static `SparseAlgebra`; every factorisation then skips the ordering.
         """
-        import klujax
-
         key = "_symbolic_aug" if augmented else "_symbolic"
         if key not in self.__dict__:
             rows, cols = self.augmented()[:2] if augmented else (self.rows, self.cols)
             size = (self.n + self.m) * (2 if augmented else 1)
-            self.__dict__[key] = klujax.analyze(jnp.asarray(rows), jnp.asarray(cols), size)
+            self.__dict__[key] = _analyze(rows, cols, size)
         return self.__dict__[key]
 
     def augmented(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -125,12 +132,8 @@ class Bordered:
 
     def symbolic(self):
         """KLU's analysis of A, made once (outside any trace) and kept here."""
-        import klujax
-
         if "_symbolic" not in self.__dict__:
-            self.__dict__["_symbolic"] = klujax.analyze(
-                jnp.asarray(self.a_rows), jnp.asarray(self.a_cols), len(self.interior)
-            )
+            self.__dict__["_symbolic"] = _analyze(self.a_rows, self.a_cols, len(self.interior))
         return self.__dict__["_symbolic"]
 
 

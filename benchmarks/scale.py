@@ -1,0 +1,155 @@
+"""Scaling of `solve` (issue 9): the clamped elastica at 10³–10⁵ edges and the simplicial-area
+Newton solve with fixed boundary up to ~10⁵ vertices, sparse path (declared locality, KLU)
+side by side with the dense path where it fits.
+
+Columns: unknowns N (free) + constraints, compile s (first call minus the median of the later
+ones), s per Newton step (median full solve / steps), steps, final scaled KKT residual, and
+peak MB = the process's peak resident set size so far (`resource.getrusage(RUSAGE_SELF)
+.ru_maxrss`, monotone over the run, so a row's value bounds that row's own peak).
+The time per step is fitted as `c nᵖ` over the sparse elastica rows with n ≥ 10³ and p is printed.
+
+Problems:
+- elastica: `energies.elastica.clamped(n, chord=(0.6, 0.2, 0), t_start=e1, t_end=e2)`, started
+  from the solved n = 64 curve resampled to n edges (`elastica.resample`), tol 1e-9.
+- area: a k×k triangulated grid on [−1, 1]² with the border fixed on the saddle
+  z = 0.25(x² − y²), the interior started on the saddle plus z-noise of 0.1 h (h the grid
+  step), then 5 Pinkall–Polthier iterations (`area.minimal_surface(method="cotan")`), then
+  `energies.area.simplicial(V, F, boundary)`, tol 1e-9 (the area gradient, max-norm).
+
+    python benchmarks/scale.py [--quick] [--repeats 3] [--dense-max 3000] [--big-area]
+
+The machine may be shared: when the load average exceeds the core count, timings are flagged.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import statistics
+import time
+
+import numpy as np
+
+import ddgjax as dg  # noqa: F401  (float64)
+from energies import area, elastica
+from solvers import solve
+
+
+def peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
+
+
+ELASTICA = dict(chord=(0.6, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+_COARSE = {}
+
+
+def elastica_problem(n: int):
+    """Started from the solved 64-edge elastica resampled to n edges (continuation in n): the
+    default great-circle start is too far for undamped-enough Newton at n ≥ 10³."""
+    if "T" not in _COARSE:
+        _COARSE["T"] = np.asarray(solve(elastica.clamped(64, **ELASTICA), tol=1e-10).x)
+    return elastica.clamped(n, **ELASTICA, x0=elastica.resample(_COARSE["T"], n))
+
+
+def saddle_grid(k: int, seed: int = 0):
+    """(V, F, boundary) of a k×k grid on [−1, 1]², z on the saddle (+ interior noise)."""
+    x = np.linspace(-1.0, 1.0, k)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    Z = 0.25 * (X**2 - Y**2)
+    V = np.stack([X, Y, Z], -1).reshape(-1, 3)
+    idx = np.arange(k * k).reshape(k, k)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    border = np.zeros((k, k), bool)
+    border[[0, -1], :] = border[:, [0, -1]] = True
+    boundary = idx[border]
+    interior = ~border.ravel()
+    h = 2.0 / (k - 1)
+    V[interior, 2] += 0.1 * h * np.random.default_rng(seed).normal(size=int(interior.sum()))
+    return V, F, boundary
+
+
+def area_problem(k: int, cotan_steps: int = 5):
+    """The noisy saddle grid after `cotan_steps` Pinkall–Polthier iterations (Fig 6.5)."""
+    V, F, b = saddle_grid(k)
+    W = area.minimal_surface(V, F, b, method="cotan", max_iter=cotan_steps, throw=False)[0]
+    return area.simplicial(W, F, b)
+
+
+def measure(problem, method: str, repeats: int, tol: float) -> dict:
+    t0 = time.perf_counter()
+    sol = solve(problem, method=method, tol=tol, throw=False)
+    first = time.perf_counter() - t0
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        sol = solve(problem, method=method, tol=tol, throw=False)
+        sol.x.block_until_ready()
+        times.append(time.perf_counter() - t0)
+    median = statistics.median(times)
+    steps = max(int(sol.steps), 1)
+    return {
+        "compile": first - median, "solve": median, "per_step": median / steps, "steps": int(sol.steps),
+        "residual": float(sol.residual), "converged": bool(sol.converged), "peak": peak_mb(),
+    }
+
+
+def row(name, n, size, method, r) -> str:
+    return (f"| {name} | {n} | {size} | {method} | {r['compile']:.2f} | {r['solve']:.3f} | {r['per_step']:.4f} | "
+            f"{r['steps']} | {r['residual']:.1e} | {r['peak']:.0f} |")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="small sizes only (elastica ≤ 10³, area ≤ 30²)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--dense-max", type=int, default=3000, help="largest N (unknowns + constraints) for the dense path")
+    ap.add_argument("--tol", type=float, default=1e-9)
+    ap.add_argument("--big-area", action="store_true",
+                    help="add the 316² ≈ 10⁵-vertex area solve (KLU fill on the 2-D mesh: > 15 min, > 6 GB on 2 cores)")
+    args = ap.parse_args()
+
+    load = os.getloadavg()[0]
+    cores = os.cpu_count() or 1
+    print(f"cores: {cores}, load average: {load:.1f}" + ("  (LOADED MACHINE: timings are inflated)" if load > cores else ""))
+    el_sizes = [100, 1000] if args.quick else [100, 300, 1000, 10_000, 100_000]
+    grid_sizes = ([10, 30] if args.quick else [10, 30, 100]) + ([316] if args.big_area else [])
+    results = []
+    print("\n| problem | n | N | method | compile s | solve s | s/step | steps | residual | peak MB |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    cases = [("elastica", n, elastica_problem) for n in el_sizes] + [("area", k * k, lambda nv, k=k: area_problem(k)) for k in grid_sizes]
+    for name, n, make in cases:
+        problem = make(n)
+        size = int(np.sum(~np.asarray(problem.fixed))) + problem.n_constraints
+        repeats = args.repeats if size < 100_000 else 1
+        for method in ("sparse", "dense"):
+            if method == "dense" and size > args.dense_max:
+                continue
+            r = measure(problem, method, repeats, args.tol)
+            results.append((name, n, method, r))
+            print(row(name, n, size, method, r), flush=True)
+
+    print()
+    el = [(n, r) for name, n, m, r in results if name == "elastica" and m == "sparse" and n >= 1000]
+    if len(el) >= 2:
+        p = np.polyfit(np.log([n for n, _ in el]), np.log([r["per_step"] for _, r in el]), 1)[0]
+        print(f"fitted exponent of s/step vs n (sparse elastica, n ≥ 10³): {p:.2f}")
+        big = dict(el).get(100_000)
+        if big is not None:
+            print(f"{'PASS' if big['converged'] and big['residual'] <= 1e-9 else 'FAIL'}: elastica 10⁵ edges residual "
+                  f"{big['residual']:.1e} ≤ 1e-9")
+            print(f"{'PASS' if big['solve'] <= 10 else 'FAIL'}: elastica 10⁵ edges solve {big['solve']:.2f} s ≤ 10 s after compile")
+            print(f"{'PASS' if big['peak'] <= 2048 else 'FAIL'}: peak memory {big['peak']:.0f} MB ≤ 2048 MB (ru_maxrss)")
+        print(f"{'PASS' if p <= 1.2 else 'FAIL'}: exponent {p:.2f} ≤ 1.2")
+    ar = [(n, r) for name, n, m, r in results if name == "area" and m == "sparse"]
+    if ar:
+        n, r = ar[-1]
+        print(f"{'PASS' if r['converged'] else 'FAIL'}: area Newton solve with {n} vertices converged "
+              f"(residual {r['residual']:.1e}, {r['steps']} steps)")
+    if load > cores:
+        print(f"note: load average {load:.1f} > {cores} cores during the run: other processes share the CPU")
+
+
+if __name__ == "__main__":
+    main()
