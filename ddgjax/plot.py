@@ -15,7 +15,7 @@ from .curves import Curve, _as_curve
 from .errors import InvalidInputError
 from .limits import ConvergenceTable
 
-__all__ = ["curve", "curves", "convergence"]
+__all__ = ["curve", "curves", "convergence", "save_figure"]
 
 
 def _pyplot():
@@ -41,16 +41,19 @@ def _polyline(gamma, closed: bool) -> np.ndarray:
     return np.vstack([points, points[:1]]) if closed else points
 
 
+def save_figure(fig, path, dpi: int = 120):
+    """Lay out `fig`, write it to `path` (PNG by its suffix), close it; returns `path`."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    _pyplot().close(fig)
+    return path
+
+
 def _finish(ax, path):
     fig = ax.figure
     if ax.name != "3d":
         ax.set_aspect("equal", adjustable="datalim")
-    if path is None:
-        return fig
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    _pyplot().close(fig)
-    return path
+    return fig if path is None else save_figure(fig, path)
 
 
 def curve(gamma: Curve, ax=None, closed: bool = False, *, path=None, vertices: bool = True, **kw):

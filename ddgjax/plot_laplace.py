@@ -13,6 +13,7 @@ from .errors import ShapeError
 from .mesh import angle_defect
 from .mesh.connectivity import from_faces
 from .mesh.curvature import boundary_vertex_mask
+from .plot import save_figure
 from .plot_surface import surface
 
 __all__ = ["harmonic_function", "minimal_surface"]
@@ -73,7 +74,4 @@ def minimal_surface(V, F, path, *, history=None, title: str = "simplicial minima
     right.set_xlabel("iteration")
     right.set_ylabel("max |∇A| at interior vertices")
     right.set_title("convergence")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110)

@@ -12,6 +12,7 @@ from _common import output_dir, run
 
 import ddgjax as dg
 from ddgjax import plot_laplace
+from ddgjax.plot import save_figure
 from ddgjax.verify.checks._surfaces import catenoid_neck, cylinder, neck_radius
 from energies import area
 
@@ -30,10 +31,7 @@ def profile(V, c: float, path):
     ax.set_xlabel("distance to the axis r")
     ax.set_ylabel("z")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def main(out=None, tiny: bool = False):

@@ -13,6 +13,7 @@ import numpy as np
 from _common import output_dir, run
 
 from ddgjax import intrinsic
+from ddgjax.plot import save_figure
 from ddgjax.verify.checks._surfaces import stretched_sphere, tall_dome
 
 
@@ -61,10 +62,7 @@ def ellipsoid(level: int, path):
     ax.plot(h, "-")
     ax.set_xlabel("flip")
     ax.set_ylabel("harmonic index h(T)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110)
 
 
 def main(out=None, tiny: bool = False):
