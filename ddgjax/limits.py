@@ -47,7 +47,8 @@ class ConvergenceTable:
         return cls(ns, errors, observed_orders(ns, errors), fitted_order(ns, errors), label)
 
     def to_markdown(self) -> str:
-        lines = [f"| n | {self.label} | observed order |", "|---:|---:|---:|"]
+        label = self.label.replace("|", "\\|")  # a label such as |γ − γ_h| must not split the column
+        lines = [f"| n | {label} | observed order |", "|---:|---:|---:|"]
         for i, (n, e) in enumerate(zip(self.ns, self.errors)):
             order = "" if i == 0 else f"{self.orders[i - 1]:.3f}"
             lines.append(f"| {n:g} | {e:.3e} | {order} |")

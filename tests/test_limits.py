@@ -36,3 +36,11 @@ def test_bad_errors_are_named():
         dg.limits.ConvergenceTable.from_errors([10, 20], [1e-3, 0.0])
     with pytest.raises(InvalidInputError, match="must increase"):
         dg.limits.ConvergenceTable.from_errors([20, 10], [1e-3, 1e-4])
+
+
+def test_markdown_escapes_bars_in_the_label():
+    """A label such as "max |γ − γ_h|" stays in one column: every row has 3 cells."""
+    table = dg.limits.ConvergenceTable.from_errors([8, 16], [1e-2, 2.5e-3], label="max |γ − γ_h|")
+    rows = [line for line in table.to_markdown().splitlines() if line.startswith("|")]
+    assert all(len(line.replace("\\|", "").strip("|").split("|")) == 3 for line in rows)
+    assert abs(table.fitted_order - 2.0) <= 1e-12
