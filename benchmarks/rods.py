@@ -192,8 +192,8 @@ def main() -> None:
         pe_err = error_to(smooth, pe["nodes"])
         base = vertex["time"]
         for name, r, detail in (
-            ("ddgjax (vertex clamp)", vertex, f"{r_steps(vertex)} Newton steps, KKT residual {vertex['residual']:.1e}"),
-            ("ddgjax (edge clamp)", edge, f"{r_steps(edge)} Newton steps, KKT residual {edge['residual']:.1e}"),
+            ("ddgjax (vertex clamp)", vertex, f"{vertex['steps']} Newton steps, KKT residual {vertex['residual']:.1e}"),
+            ("ddgjax (edge clamp)", edge, f"{edge['steps']} Newton steps, KKT residual {edge['residual']:.1e}"),
             ("PyElastica", pe, f"{pe['steps']} time steps to t = {pe['sim_time']:.2f}, max speed {pe['speed']:.1e}"),
         ):
             err = error_to(smooth, r["nodes"])
@@ -218,10 +218,6 @@ def main() -> None:
 
 def ratio(x: float) -> str:
     return f"{x:.2g}×" if x < 10 else f"{x:.0f}×"
-
-
-def r_steps(r: dict) -> int:
-    return r["steps"]
 
 
 if __name__ == "__main__":

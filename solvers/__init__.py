@@ -8,7 +8,8 @@ parameters in one call, vectorised and sharded over devices.  This package knows
 
 import ddgjax as _ddgjax  # noqa: F401  (switches on float64 before anything is traced)
 
-from ._solve import Solution as Solution, solve as solve
 from ._batch import solve_batch as solve_batch
+from ._solve import Solution as Solution
+from ._solve import solve as solve
 
 __all__ = ["solve", "solve_batch", "Solution"]

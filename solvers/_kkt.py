@@ -99,9 +99,6 @@ class KKT:
         """`R(w) = (∇E − Jᵀλ, −g)`."""
         return jax.grad(self.lagrangian)(w)
 
-    def kkt_matvec(self, w, v):
-        """`K(w) v` by one forward-over-reverse product."""
-        return jax.jvp(self.residual, (w,), (v,))[1]
 
 
 def residual_weights(problem, spec: Spec):

@@ -45,7 +45,17 @@ def _regularisation(n: int, m: int, mu):
     return jnp.concatenate([jnp.full((n,), mu), jnp.full((m,), -mu)])
 
 
-class DenseAlgebra:
+class _Algebra:
+    """The compositions shared by both back ends."""
+
+    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
+        return self.factor_matrix(kkt, self.matrix(kkt, w, identity_hessian), mu_rel)
+
+    def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
+        return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
+
+
+class DenseAlgebra(_Algebra):
     """Dense KKT matrix by `jax.hessian` of the Lagrangian; LU solve."""
 
     def __hash__(self):
@@ -67,14 +77,8 @@ class DenseAlgebra:
         K = K + jnp.diag(_regularisation(kkt.spec.n, kkt.spec.m, jnp.maximum(mu_rel * scale, MU_FLOOR)))
         return jax.scipy.linalg.lu_factor(K)
 
-    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
-        return self.factor_matrix(kkt, self.matrix(kkt, w, identity_hessian), mu_rel)
-
     def apply(self, fac, b):
         return jax.scipy.linalg.lu_solve(fac, b)
-
-    def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
-        return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
 
     def matvec(self, K, v):
         return K @ v
@@ -117,7 +121,7 @@ def _bordered_solve(split, values, b):
     return jnp.zeros_like(b).at[split.interior].set(x_interior).at[split.border].set(x_border)
 
 
-class SparseAlgebra:
+class SparseAlgebra(_Algebra):
     """Sparse KKT matrix assembled from local blocks; KLU solve (klujax)."""
 
     def __init__(self, pattern: SparsePattern):
@@ -153,17 +157,11 @@ class SparseAlgebra:
         diagonal = p.target[p.source.shape[0]:]  # where the n + m diagonal entries were summed
         return K.at[diagonal].add(_regularisation(n, m, jnp.maximum(mu_rel, MU_FLOOR) * scale))
 
-    def factor(self, kkt: KKT, w, mu_rel, identity_hessian=False):
-        return self.factor_matrix(kkt, self.matrix(kkt, w, identity_hessian), mu_rel)
-
     def apply(self, fac, b):
         split = self.pattern.split()
         if split is not None:
             return _bordered_solve(split, fac, b)
         return _klu_solve(self.pattern.rows, self.pattern.cols, fac, b, self.pattern.symbolic())
-
-    def solve(self, kkt: KKT, w, mu_rel, b, identity_hessian=False):
-        return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
 
     def matvec(self, K, v):
         p = self.pattern
