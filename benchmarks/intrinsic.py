@@ -11,32 +11,34 @@ time (`time.process_time`, all three run on one core) are reported: on a shared 
 time is the fairer measure.  The flip phase is also timed alone (`flip_to_delaunay` on a prebuilt
 triangulation, no history) and divided by the flip count.
 
-    python benchmarks/intrinsic.py [--quick] [--repeats 3] [--repeats-large 2] [--rl-repeats-large 0]
+    python benchmarks/intrinsic.py [--quick | --large] [--repeats 3] [--repeats-large 2] [--rl-repeats-large 0]
 
-Measured 2026-11-22 on the shared 2-core development machine (load average 4–6 from other jobs,
-so wall times are inflated and noisy; CPU times are the comparison), libigl and robust-laplacian
-from pip, medians of 3 (2 above 5·10⁵ faces; robust-laplacian once there):
+Measured 2026-11-22 on the shared 2-core development machine (other jobs running: CPU times are
+the comparison), libigl and robust-laplacian from pip, medians of 3 (2 above 5·10⁵ faces;
+robust-laplacian once there):
 
 | mesh | faces | flips | rounds | flip phase CPU (ns/flip) | ddgjax CPU (s) | libigl CPU (s) | robust-laplacian CPU (s) | igl / ddgjax | rl / ddgjax | ddgjax wall (s) | libigl wall (s) | robust-laplacian wall (s) | max rel diff vs igl |
 |---|---|---|---|---|---|---|---|---|---|---|---|---|---|
-| sphere | 20480 | 0 | 0 | – | 0.016 | 0.015 | 0.074 | 0.93 | 4.64 | 0.032 | 0.039 | 0.174 | 3.7e-16 |
-| sphere | 81920 | 0 | 0 | – | 0.077 | 0.085 | 0.378 | 1.10 | 4.91 | 0.155 | 0.183 | 0.834 | 4.9e-16 |
-| sphere | 1310720 | 0 | 0 | – | 1.353 | 1.461 | 7.829 | 1.08 | 5.78 | 2.051 | 2.150 | 16.114 | 4.9e-16 |
-| ellipsoid 20:1:1 | 20480 | 32043 | 16 | 645 | 0.046 | 0.037 | 0.195 | 0.80 | 4.25 | 0.078 | 0.065 | 0.268 | 4.0e-13 |
-| ellipsoid 20:1:1 | 81920 | 128982 | 17 | 553 | 0.152 | 0.152 | 0.824 | 1.00 | 5.42 | 0.229 | 0.192 | 1.175 | 2.5e-12 |
-| ellipsoid 20:1:1 | 1310720 | 2037699 | 17 | 550 | 2.387 | 2.804 | 23.270 | 1.17 | 9.75 | 4.795 | 5.482 | 44.906 | 2.5e-12 |
-| sheared torus | 10000 | 15380 | 15 | 475 | 0.012 | 0.009 | 0.021 | 0.69 | 1.73 | 0.026 | 0.026 | 0.041 | 1.5e-13 |
-| sheared torus | 102400 | 158208 | 10 | 387 | 0.099 | 0.080 | 0.306 | 0.81 | 3.08 | 0.196 | 0.186 | 0.635 | 3.6e-15 |
-| sheared torus | 1310720 | 2552580 | 12 | 373 | 1.516 | 1.185 | 6.610 | 0.78 | 4.36 | 2.343 | 1.814 | 9.448 | 3.4e-15 |
+| sphere | 20480 | 0 | 0 | – | 0.006 | 0.014 | 0.040 | 2.20 | 6.34 | 0.006 | 0.014 | 0.040 | 4.9e-16 |
+| sphere | 81920 | 0 | 0 | – | 0.024 | 0.056 | 0.204 | 2.28 | 8.38 | 0.024 | 0.056 | 0.207 | 4.9e-16 |
+| sphere | 1310720 | 0 | 0 | – | 0.497 | 1.373 | 8.440 | 2.76 | 16.98 | 0.499 | 1.345 | 8.567 | 6.1e-16 |
+| ellipsoid 20:1:1 | 20480 | 32043 | 16 | 277 | 0.015 | 0.019 | 0.068 | 1.24 | 4.38 | 0.015 | 0.019 | 0.068 | 4.0e-13 |
+| ellipsoid 20:1:1 | 81920 | 129391 | 17 | 354 | 0.058 | 0.106 | 0.564 | 1.83 | 9.74 | 0.058 | 0.105 | 0.564 | 2.5e-12 |
+| ellipsoid 20:1:1 | 1310720 | 2037985 | 17 | 343 | 1.067 | 2.385 | 17.137 | 2.24 | 16.06 | 1.067 | 2.355 | 17.146 | 2.5e-12 |
+| sheared torus | 10000 | 15380 | 15 | 319 | 0.007 | 0.007 | 0.016 | 0.94 | 2.24 | 0.007 | 0.007 | 0.016 | 1.5e-13 |
+| sheared torus | 102400 | 158208 | 10 | 204 | 0.051 | 0.069 | 0.265 | 1.34 | 5.15 | 0.051 | 0.069 | 0.265 | 3.6e-15 |
+| sheared torus | 1310720 | 2552580 | 12 | 295 | 0.871 | 1.275 | 5.907 | 1.46 | 6.79 | 0.873 | 1.272 | 5.909 | 3.4e-15 |
 
-Reading: at 1.3·10⁶ faces ddgjax is 1.08–1.17× faster than libigl on the sphere and the stretched
-ellipsoid and 0.7–0.8× its speed on the sheared torus, and 4–10× faster than robust-laplacian
-(1.7× on the smallest torus).  The flip loop costs 0.4–0.65 µs per flip (vectorised numpy,
-no JIT), against about 0.07–0.1 µs for a compiled sequential loop: ddgjax makes up for it in the
-gluing and assembly.  Time grows about linearly: from 10⁵ to 1.3·10⁶ faces (×13–16) it grows
-×15–18 (cache misses add a little); meshes whose vertex labels are not spatially coherent are
+Reading: at 1.3·10⁶ faces ddgjax is 1.5× faster than libigl on the sheared torus, 2.2× on the
+stretched ellipsoid and 2.8× on the sphere, and 7–17× faster than robust-laplacian (2.2× on
+the smallest torus, where libigl and ddgjax tie).  The flip loop costs 0.2–0.35 µs per flip
+(vectorised numpy, no JIT; scattered writes and boolean compressions dominate, so a flip writes
+as few entries as it can), against about 0.07–0.1 µs for a compiled sequential loop: ddgjax
+makes up for it in the gluing (one sort of the halfedges), the renumbering (radix sorts) and
+the assembly.  Time grows about linearly: from 10⁵ to 1.3·10⁶ faces (×13–16) it grows ×17–21
+(cache misses add a little); meshes whose vertex labels are not spatially coherent are
 renumbered along a Morton curve first (`ddgjax.intrinsic.ordering`), which halves the flip time
-on the icospheres.
+on the icospheres.  `--large` runs only the 1.3·10⁶-face meshes.
 """
 
 from __future__ import annotations
@@ -63,9 +65,9 @@ def _sheared_torus(m, n):
     return V @ shear.T, F
 
 
-def meshes(quick: bool):
-    levels = (4, 5) if quick else (5, 6, 8)
-    tori = ((35, 70), (80, 160)) if quick else ((50, 100), (160, 320), (512, 1280))
+def meshes(quick: bool, large: bool = False):
+    levels = (4, 5) if quick else (8,) if large else (5, 6, 8)
+    tori = ((35, 70), (80, 160)) if quick else ((512, 1280),) if large else ((50, 100), (160, 320), (512, 1280))
     for level in levels:
         yield "sphere", icosphere(level)
     for level in levels:
@@ -119,6 +121,7 @@ def _row(name, V, F, igl, rl, repeats, rl_repeats):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="small meshes only")
+    parser.add_argument("--large", action="store_true", help="the meshes of about 1.3e6 faces only")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--repeats-large", type=int, default=2, help="repeats above 5e5 faces")
     parser.add_argument("--rl-repeats-large", type=int, default=0,
@@ -137,7 +140,7 @@ def main():
           "| robust-laplacian CPU (s) | igl / ddgjax | rl / ddgjax | ddgjax wall (s) | libigl wall (s) "
           "| robust-laplacian wall (s) | max rel diff vs igl |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for name, (V, F) in meshes(args.quick):
+    for name, (V, F) in meshes(args.quick, args.large):
         large = len(F) > 500_000
         repeats = args.repeats_large if large else args.repeats
         rl_repeats = args.rl_repeats_large if large else args.repeats

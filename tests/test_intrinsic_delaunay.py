@@ -210,3 +210,34 @@ def test_gluing_stays_consistent_through_many_batched_flips():
     np.testing.assert_array_equal(out.edge[out.halfedges[:, 0]], np.arange(out.n_edges))
     np.testing.assert_array_equal(out.edge[out.halfedges[:, 1]], np.arange(out.n_edges))
     np.testing.assert_allclose(T.cone_angles(out), T.cone_angles(tri), atol=1e-10)
+
+
+def test_cached_cotangents_of_the_result_equal_a_fresh_computation():
+    """The flip loop keeps only the keys cot + tol · s and recovers the cotangents of the result
+    from them (the cotangents of a face sum to s, Lemma 7.17): they agree with the law of
+    cosines on the final lengths to rounding, and so does h(T)."""
+    V, F = icosphere(3)
+    tri = T.from_mesh(V * np.array([12.0, 1.0, 0.5]), F)
+    result = dg.intrinsic.flip_to_delaunay(tri)
+    assert result.n_flips > 500
+    fresh = T.corner_cotangents(result.triangulation)  # corner k is opposite side k + 1
+    per_side = np.roll(fresh, 1, axis=1).reshape(-1)
+    scale = np.abs(fresh).sum(axis=1).repeat(3)
+    assert np.max(np.abs(result.halfedge_cotangents - per_side) / scale) < 1e-13
+    unrecorded = dg.intrinsic.flip_to_delaunay(tri, record_history=False)
+    np.testing.assert_allclose(unrecorded.harmonic_index[-1], dg.intrinsic.harmonic_index(result), rtol=1e-13)
+
+
+def test_flipping_in_place_equals_flipping_a_copy():
+    """`flip_owned(copy=False)` (used by `laplace_beltrami` on triangulations it built itself)
+    gives the same triangulation as the copying `flip_to_delaunay`."""
+    from ddgjax.intrinsic.delaunay import flip_owned
+
+    V, F = torus(40, 12)
+    V = V @ np.array([[1.0, 0.0, 1.5], [0.0, 0.5, 0.0], [0.0, 0.0, 1.0]]).T
+    copied = dg.intrinsic.flip_to_delaunay(T.from_mesh(V, F))
+    in_place = flip_owned(T.from_mesh(V, F), copy=False)
+    assert copied.n_flips == in_place.n_flips > 100
+    for a, b in zip((copied.F, copied.triangulation.edge, copied.triangulation.halfedges, copied.lengths),
+                    (in_place.F, in_place.triangulation.edge, in_place.triangulation.halfedges, in_place.lengths)):
+        np.testing.assert_array_equal(a, b)

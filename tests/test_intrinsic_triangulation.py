@@ -171,8 +171,11 @@ def test_flip_budget_raises_instead_of_hanging():
         dg.intrinsic.flip_to_delaunay(dg.intrinsic.from_mesh(V * [8.0, 1, 1], F), max_flips=3)
 
 
-def test_inputs_not_mutated():
-    V, F = icosphere(2)
+@pytest.mark.parametrize("mesh", [lambda: icosphere(2), lambda: torus(30, 10)])
+def test_inputs_not_mutated(mesh):
+    """Also through `laplace_beltrami`'s in-place flips (on its own copies), with and without
+    the internal renumbering (the icosphere's labels are renumbered, the torus grid's not)."""
+    V, F = mesh()
     V = V * [5.0, 1, 1]
     V0, F0 = V.copy(), F.copy()
     tri = T.from_mesh(V, F)
@@ -184,3 +187,12 @@ def test_inputs_not_mutated():
     np.testing.assert_array_equal(F, F0)
     for a, b in zip(arrays, (tri.F, tri.edge, tri.halfedges, tri.lengths)):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("top", [1, 70_000, 2**40])
+def test_radix_argsort_is_the_stable_argsort(top):
+    from ddgjax.intrinsic.ordering import radix_argsort
+
+    keys = np.random.default_rng(top % 97).integers(0, top, 50_000)
+    np.testing.assert_array_equal(radix_argsort(keys), np.argsort(keys, kind="stable"))
+    assert radix_argsort(keys[:0]).size == 0

@@ -11,10 +11,14 @@
   non-Delaunay ones an independent set (no two share a triangle: the edge of smallest fixed
   pseudo-random priority, a hash of its index, in each of its triangles), flip them all at once
   (`flips.flip_batch`, equal to flipping them one after another), and queue the not-chosen ones
-  and the four outer edges of every flipped quadrilateral for the next round.  Every flip is one
-  step of Fig 7.13, recorded in the history.  The cotangents of all corners and the areas and
-  harmonic indices of all faces are cached and updated at each flip, so a test is a few array
-  lookups.  No JIT: numpy's vectorised gathers and scatters, about 0.5–1 µs per flip.
+  and those of the four outer edges of every flipped quadrilateral that fail the test after the
+  batch (an edge whose triangles change again later is tested again by that later flip, so the
+  queue always holds every edge that may be non-Delaunay).  Every flip is one step of Fig 7.13,
+  recorded in the history.  The test keys cot + tol · s of all corners and the areas of all
+  faces are cached and updated at each flip, so a test is four array lookups; the cotangents of
+  the result are computed once at the end.  No JIT: numpy's vectorised gathers and scatters,
+  about 0.2–0.35 µs per flip on 10⁶ faces (scattered writes and boolean compressions are the
+  cost, so a flip writes as few entries as it can: see `flips.flip_batch`).
 
 Surfaces with boundary (which the reference does not treat) keep their boundary edges; only
 interior edges are tested and flipped, as in libigl's `intrinsic_delaunay_triangulation`.
@@ -33,8 +37,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import FlipBudgetError, InvalidInputError
-from .flips import flip_batch, quad
-from .geometry import cotangent, face_harmonic_index, flipped_length, triangle_area
+from .flips import flip_batch, others
+from .geometry import face_harmonic_index, flipped_length, triangle_area
 from .triangulation import Triangulation, from_faces, side_lengths
 
 __all__ = [
@@ -43,6 +47,7 @@ __all__ = [
     "as_triangulation",
     "delaunay_edges",
     "edge_cotangent_sums",
+    "flip_owned",
     "flip_to_delaunay",
     "harmonic_index",
     "is_delaunay",
@@ -73,12 +78,17 @@ def _interior(tri: Triangulation) -> np.ndarray:
 
 def _face_geometry(tri: Triangulation):
     """(cot, area, s): per halfedge the cot of the angle opposite it (3 nf,), per face its area
-    and s = (a² + b² + c²)/4A = h(Δ)/4 (nf,)."""
+    and s = (a² + b² + c²)/4A = h(Δ)/4 (nf,).  Side i of a face is opposite its corner i + 2;
+    cot opposite side i = (l_{i+1}² + l_{i+2}² − l_i²)/4A (law of cosines, eq 6.3)."""
     L = side_lengths(tri)
-    A = triangle_area(L[:, 0], L[:, 1], L[:, 2])
-    # side i of a face is opposite its corner i + 2
-    cots = cotangent(L, np.roll(L, -1, axis=1), np.roll(L, 1, axis=1), A[:, None])
-    return cots.reshape(-1), A, 0.25 * face_harmonic_index(L[:, 0], L[:, 1], L[:, 2], A)
+    a, b, c = L[:, 0].copy(), L[:, 1].copy(), L[:, 2].copy()  # contiguous columns
+    A = triangle_area(a, b, c)
+    a2, b2, c2 = a * a, b * b, c * c
+    inv = 0.25 / A
+    cots = np.empty_like(L)
+    for i, (p, q, r) in enumerate(((b2, c2, a2), (c2, a2, b2), (a2, b2, c2))):
+        cots[:, i] = (p + q - r) * inv
+    return cots.reshape(-1), A, (a2 + b2 + c2) * inv
 
 
 def edge_cotangent_sums(tri: Triangulation) -> np.ndarray:
@@ -163,36 +173,51 @@ class FlipResult:
 
 @dataclass(eq=False)
 class _Work:
-    """Mutable working copy for the flip loop: the flat gluing arrays; per halfedge the cot of the
-    opposite angle and key = cot + tol · s(face), per face its area and s = h(Δ)/4 = Σ cot (kept
-    up to date at each flip, so that the test of an edge, key(h) + key(t) < 0, is four lookups)."""
+    """Mutable working copy for the flip loop: the flat gluing arrays; per halfedge the test key
+    cot + tol · s(face) of the opposite angle (one more entry, +inf, read by the boundary's
+    halfedge -1, so that boundary edges always pass), per face its area (kept up to date at each
+    flip, so that the test of an edge, key(h) + key(t) < 0, is four lookups).  The cotangents
+    of the result are computed once at the end."""
 
     F: np.ndarray
     edge: np.ndarray
     halfedges: np.ndarray
     lengths: np.ndarray
-    cot: np.ndarray
     key: np.ndarray
     area: np.ndarray
-    scale: np.ndarray
     scratch: np.ndarray
     tol: float
 
     @classmethod
-    def of(cls, tri: Triangulation, tol: float) -> _Work:
-        cots, A, scales = _face_geometry(tri)
-        return cls(tri.F.reshape(-1).copy(), tri.edge.copy(), tri.halfedges.copy(), tri.lengths.copy(),
-                   cots, cots + tol * np.repeat(scales, 3), A, scales,
-                   np.full(tri.n_edges, np.iinfo(np.int64).max, dtype=np.int64), tol)
+    def of(cls, tri: Triangulation, tol: float, geometry, copy: bool = True) -> _Work:
+        """The working copy (`copy=False`: work in the arrays of `tri`, which the caller owns)."""
+        cots, A, scales = geometry
+        key = np.empty(cots.size + 1)
+        np.add(cots.reshape(-1, 3), tol * scales[:, None], out=key[:-1].reshape(-1, 3))
+        key[-1] = np.inf
+        arrays = (tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths)
+        if copy:
+            arrays = tuple(a.copy() for a in arrays)
+        return cls(*arrays, key, A, np.full(tri.n_edges, _NONE, dtype=np.int64), tol)
+
+    def cotangents(self):
+        """(cot (3 nf,), s (nf,)) from the keys: the keys of a face sum to s (1 + 3 tol), since
+        its three cotangents sum to s (Lemma 7.17)."""
+        k = self.key[:-1].reshape(-1, 3)
+        s = (k[:, 0] + k[:, 1] + k[:, 2]) / (1.0 + 3.0 * self.tol)
+        return (k - (self.tol * s)[:, None]).reshape(-1), s
 
     def arrays(self):
         return self.F, self.edge, self.halfedges, self.lengths
 
 
 def _failing(w: _Work, e):
-    """bool mask over the interior edges `e`: the angle test fails (Prop 7.9 with the tie
-    tolerance: cot α + tol s₁ + cot β + tol s₂ < 0), read from the cached keys."""
+    """bool mask over the edges `e`: the angle test fails (Prop 7.9 with the tie tolerance:
+    cot α + tol s₁ + cot β + tol s₂ < 0), read from the cached keys."""
     return w.key[w.halfedges[:, 0][e]] + w.key[w.halfedges[:, 1][e]] < 0
+
+
+_NONE = np.iinfo(np.int64).max
 
 
 def _priority(e):
@@ -202,14 +227,14 @@ def _priority(e):
 
 
 def _independent(bad, sides, scratch) -> np.ndarray:
-    """bool mask over `bad`: the edges of least priority among the non-Delaunay edges of both of
-    their triangles (`sides`: the four other edges of those triangles)."""
+    """bool mask over `bad` (distinct edges): the edges of least priority among the non-Delaunay
+    edges of both of their triangles (`sides`: the four other edges of those triangles)."""
     own = _priority(bad)
     scratch[bad] = own
     best = own
     for side in sides:
         best = np.minimum(best, scratch[side])
-    scratch[bad] = np.iinfo(np.int64).max
+    scratch[bad] = _NONE
     return own == best
 
 
@@ -220,42 +245,73 @@ def _unique(e: np.ndarray, scratch_marks: np.ndarray) -> np.ndarray:
     return e[scratch_marks[e] == position]
 
 
-def _new_face_geometry(w: _Work, slots, l_cd, l_x, l_y):
-    """Store area, s and the three opposite cotangents of the new faces with sides (cd, x, y) on
-    the slots (first, next, next of next)."""
-    B = triangle_area(l_cd, l_x, l_y)
-    face = slots[0] // 3
+def _sums_of_squares(x, y, z, area):
+    """s = (x² + y² + z²) / 4A = h(Δ)/4 (Def 7.7, Lemma 7.17) and the squares."""
+    x2, y2, z2 = x * x, y * y, z * z
+    return (x2 + y2 + z2) / (4.0 * area), (x2, y2, z2)
+
+
+def _new_face_keys(w: _Work, slots, face, x, y, z):
+    """Store the area of the new faces with sides x, y, z on `slots` (in order) and the keys
+    cot + tol · s of the angles opposite them (cot opposite x = (y² + z² − x²)/4A); returns s
+    and the three keys."""
+    B = triangle_area(x, y, z)
     w.area[face] = B
-    w.scale[face] = s = 0.25 * face_harmonic_index(l_cd, l_x, l_y, B)
-    for slot, (a, b, c) in zip(slots, ((l_cd, l_x, l_y), (l_x, l_y, l_cd), (l_y, l_cd, l_x))):
-        w.cot[slot] = cot = cotangent(a, b, c, B)
-        w.key[slot] = cot + w.tol * s
+    s, (x2, y2, z2) = _sums_of_squares(x, y, z, B)
+    inv, shift = 0.25 / B, w.tol * s
+    keys = []
+    for slot, (p, q, r) in zip(slots, ((y2, z2, x2), (z2, x2, y2), (x2, y2, z2))):
+        w.key[slot] = k = (p + q - r) * inv + shift
+        keys.append(k)
+    return s, keys
 
 
 def _flip_round(w: _Work, queue, record):
-    """Test the edges `queue`, flip an independent set of the non-Delaunay ones.  Returns
-    (flipped edges, harmonic-index steps or None, edges to test next: the non-Delaunay ones not
-    flipped and the sides of the flipped quadrilaterals)."""
-    bad = queue[_failing(w, queue)]
-    if bad.size == 0:
-        return bad, None, bad
-    slots, sides, ls = quad(*w.arrays(), bad)
-    chosen = _independent(bad, sides, w.scratch)
-    sel = bad[chosen]
-    slots, sides, ls = (tuple(x[chosen] for x in group) for group in (slots, sides, ls))
-    f, g = slots[0] // 3, slots[3] // 3
-    before = w.scale[f] + w.scale[g]
-    new = flipped_length(*ls, w.area[f], w.area[g])
-    flip_batch(*w.arrays(), sel, (slots, sides), new)
-    _, l_bc, l_ca, l_ad, l_db = ls
-    # (d, c, a) on h, h1, h2 with sides cd, ca, ad and (c, d, b) on t, t1, t2 with cd, db, bc
-    _new_face_geometry(w, slots[:3], new, l_ca, l_ad)
-    _new_face_geometry(w, slots[3:], new, l_db, l_bc)
-    steps = 4.0 * (w.scale[f] + w.scale[g] - before) if record else None
-    outer = np.concatenate(sides)
-    h, t = w.halfedges[:, 0][outer], w.halfedges[:, 1][outer]
-    outer = outer[(t >= 0) & (h // 3 != t // 3)]
-    return sel, steps, np.concatenate([bad[~chosen], outer])
+    """Test the distinct edges `queue`, flip an independent set of the non-Delaunay ones (no
+    two share a triangle; the other non-Delaunay ones wait for the next round).  Returns (number
+    of flips, harmonic-index steps or None, edges to test next: the non-Delaunay ones not
+    flipped and the sides of the flipped quadrilaterals that fail the test after the whole
+    batch; a side whose triangles change again later is tested again by that flip).  Boundary
+    edges pass the test (key +inf), and so does an edge lying twice on one triangle (its two
+    opposite angles are equal and acute); the `f != g` guard only protects against rounding
+    (such an edge is dropped, never flipped, so that a round cannot stall)."""
+    e = queue[_failing(w, queue)]
+    if e.size == 0:
+        return 0, None, e
+    F, edge, halfedges, lengths = w.arrays()
+    h, t = halfedges[:, 0][e], halfedges[:, 1][e]
+    f, g = h // 3, t // 3
+    h1, h2 = others(h, f)
+    t1, t2 = others(t, g)
+    sides = (edge[h1], edge[h2], edge[t1], edge[t2])
+    distinct = f != g
+    chosen = _independent(e, sides, w.scratch) & distinct
+    rest = e[~chosen & distinct]  # (an edge twice on one triangle is never flipped: not kept)
+    if not chosen.all():
+        e, h, t = e[chosen], h[chosen], t[chosen]
+        sides = tuple(x[chosen] for x in sides)
+        f, g = h // 3, t // 3
+        h1, h2 = others(h, f)
+        t1, t2 = others(t, g)
+    l_ab = lengths[e]
+    l_bc, l_ca, l_ad, l_db = (lengths[x] for x in sides)
+    A1, A2 = w.area[f], w.area[g]
+    new = flipped_length(l_ab, l_bc, l_ca, l_ad, l_db, A1, A2)
+    flip_batch(F, edge, halfedges, lengths, e, ((h, h1, h2, t, t1, t2), sides), new)
+    # (a, d, c) on h, h1, h2 with sides ad, dc, ca and (b, c, d) on t, t1, t2 with bc, cd, db
+    s_f, (k_ad, _, k_ca) = _new_face_keys(w, (h, h1, h2), f, l_ad, new, l_ca)
+    s_g, (k_bc, _, k_db) = _new_face_keys(w, (t, t1, t2), g, l_bc, new, l_db)
+    steps = None
+    if record:
+        before = _sums_of_squares(l_ab, l_bc, l_ca, A1)[0] + _sums_of_squares(l_ab, l_ad, l_db, A2)[0]
+        steps = 4.0 * (s_f + s_g - before)
+    # the sides that now fail: own key (just computed) + key of the other halfedge (the other
+    # column of halfedges[side]; -1 on the boundary, whose key is +inf)
+    H0, H1 = halfedges[:, 0], halfedges[:, 1]
+    pushed = [rest]
+    for x, slot, k in zip(sides, (t, h2, h, t2), (k_bc, k_ca, k_ad, k_db)):
+        pushed.append(x[k + w.key[H0[x] + H1[x] - slot] < 0])
+    return e.size, steps, np.concatenate(pushed)
 
 
 def flip_to_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL, max_flips: int | None = None,
@@ -271,30 +327,40 @@ def flip_to_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL, max_flips: i
     **Raises:** the errors of `triangulation.from_faces`; `FlipBudgetError` when the budget is
     used up (naming an edge that is still not Delaunay).
     """
-    tri = as_triangulation(F, lengths)
+    return flip_owned(as_triangulation(F, lengths), tol, max_flips, record_history, copy=True)
+
+
+def flip_owned(tri: Triangulation, tol: float = DELAUNAY_TOL, max_flips: int | None = None,
+               record_history: bool = False, copy: bool = False) -> FlipResult:
+    """`flip_to_delaunay` of a triangulation whose arrays the caller owns: with `copy=False` they
+    are flipped in place (and `tri` must not be used afterwards)."""
     budget = 50 * tri.n_faces + 1000 if max_flips is None else int(max_flips)
-    w = _Work.of(tri, tol)
+    geometry = _face_geometry(tri)
+    w = _Work.of(tri, tol, geometry, copy)
     marks = np.zeros(tri.n_edges, dtype=np.int64)
-    queue = _interior(tri)
-    queue = queue[_failing(w, queue)]
-    h0 = 4.0 * float(w.scale.sum())
+    queue = np.flatnonzero(_failing(w, slice(None)))  # boundary edges pass (key +inf)
+    h0 = 4.0 * float(geometry[2].sum())
     steps, n_flips, n_rounds = [], 0, 0
     while queue.size:
         parts, before = [], n_flips
         for start in range(0, queue.size, CHUNK):
             flipped, step, more = _flip_round(w, queue[start:start + CHUNK], record_history)
-            n_flips += flipped.size
+            n_flips += flipped
             parts.append(more)
             if step is not None:
                 steps.append(step)
             if n_flips > budget:
                 raise FlipBudgetError(
-                    f"flip budget of {budget} flips used up after {n_rounds} rounds; edge {more[0]} is "
-                    "still not Delaunay (raise max_flips, or check the lengths for near-degenerate triangles)"
+                    f"flip budget of {budget} flips used up after {n_rounds} rounds; edge "
+                    f"{more[0] if more.size else queue[start]} is still not Delaunay (raise max_flips, or "
+                    "check the lengths for near-degenerate triangles)"
                 )
         queue = _unique(np.concatenate(parts), marks)
         n_rounds += n_flips > before
-    out = replace(tri, F=w.F.reshape(-1, 3), edge=w.edge, halfedges=w.halfedges, lengths=w.lengths)
+    out, (cots, _, scales) = tri, geometry
+    if n_flips:
+        out = replace(tri, F=w.F.reshape(-1, 3), edge=w.edge, halfedges=w.halfedges, lengths=w.lengths)
+        cots, scales = w.cotangents()
     steps = np.concatenate(steps) if steps else np.zeros(0)
-    history = h0 + np.concatenate([[0.0], np.cumsum(steps)]) if record_history else np.array([h0, 4.0 * float(w.scale.sum())])
-    return FlipResult(out, n_flips, n_rounds, history, steps, w.cot)
+    history = h0 + np.concatenate([[0.0], np.cumsum(steps)]) if record_history else np.array([h0, 4.0 * float(scales.sum())])
+    return FlipResult(out, n_flips, n_rounds, history, steps, cots)

@@ -31,7 +31,7 @@ from .delaunay import (
     DELAUNAY_TOL,
     as_triangulation,
     edge_cotangent_sums,
-    flip_to_delaunay,
+    flip_owned,
 )
 from .geometry import face_harmonic_index, triangle_area
 from .ordering import is_local, local_numbering
@@ -39,7 +39,9 @@ from .triangulation import (
     Triangulation,
     checked_faces,
     checked_positions,
+    from_checked_mesh,
     from_mesh,
+    next_halfedge,
     side_lengths,
 )
 
@@ -65,20 +67,26 @@ def cotan_laplacian(tri: Triangulation, weights=None, labels=None) -> sp.csr_mat
     (default the identity).
     """
     w = cotan_weights(tri) if weights is None else weights
-    i, j = tri.edges.T
-    if labels is not None:
-        i, j = labels[i], labels[j]
-    keep = i != j
-    i, j, w = i[keep], j[keep], w[keep]
     n = tri.n_vertices
+    index = np.int32 if n < np.iinfo(np.int32).max else np.int64  # scipy's own index type
+    F = tri.F.reshape(-1).astype(index)
+    h, t = tri.halfedges[:, 0], tri.halfedges[:, 1]
+    i, j = F[h], F[t]  # the head of h is the tail of its twin t
+    boundary = np.flatnonzero(t < 0)
+    j[boundary] = F[next_halfedge(h[boundary])]
+    if labels is not None:
+        i, j = labels[i].astype(index), labels[j].astype(index)
+    w = np.where(i != j, w, 0.0)  # loops drop out
     diagonal = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
-    rows = np.concatenate([i, j, np.arange(n)])
-    cols = np.concatenate([j, i, np.arange(n)])
+    vertices = np.arange(n, dtype=index)
+    rows = np.concatenate([i, j, vertices])
+    cols = np.concatenate([j, i, vertices])
     return sp.csr_matrix((np.concatenate([-w, -w, diagonal]), (rows, cols)), shape=(n, n))
 
 
-def _delaunay_laplacian(tri: Triangulation, tol: float, labels=None) -> sp.csr_matrix:
-    result = flip_to_delaunay(tri, tol=tol, record_history=False)
+def _delaunay_laplacian(tri: Triangulation, tol: float, labels=None, owned: bool = False) -> sp.csr_matrix:
+    """`owned`: `tri` was built here, its arrays may be flipped in place."""
+    result = flip_owned(tri, tol, copy=not owned)
     return cotan_laplacian(result.triangulation, result.cotan_weights(), labels)
 
 
@@ -105,14 +113,14 @@ def laplace_beltrami(V, F, *, tol: float = DELAUNAY_TOL) -> sp.csr_matrix:
     V = checked_positions(V)
     F, _ = checked_faces(F, V.shape[0])
     if is_local(F, V.shape[0]):
-        return _delaunay_laplacian(from_mesh(V, F), tol)
+        return _delaunay_laplacian(from_checked_mesh(V, F), tol, owned=True)
     order, F_local = local_numbering(V, F)
     try:
-        tri = from_mesh(V[order], F_local)
+        tri = from_checked_mesh(np.take(V, order, axis=0), F_local)
     except DDGError:
         from_mesh(V, F)  # the same error, with the caller's indices
         raise
-    return _delaunay_laplacian(tri, tol, labels=order)
+    return _delaunay_laplacian(tri, tol, labels=order, owned=True)
 
 
 @dataclass(frozen=True, eq=False)

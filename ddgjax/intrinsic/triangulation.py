@@ -43,6 +43,7 @@ __all__ = [
     "cone_angles",
     "corner_angles",
     "corner_cotangents",
+    "from_checked_mesh",
     "from_faces",
     "from_gluing",
     "from_mesh",
@@ -91,7 +92,8 @@ class Triangulation:
 
 def next_halfedge(h):
     """The next halfedge in the same face: 3 f + (i + 1 mod 3)."""
-    return h + np.where(h % 3 == 2, -2, 1)
+    h = np.asarray(h)
+    return np.where(h - 3 * (h // 3) == 2, h - 2, h + 1)
 
 
 def side_lengths(tri: Triangulation) -> np.ndarray:
@@ -110,10 +112,14 @@ def _check_lengths(tri: Triangulation) -> None:
     if bad.size:
         raise TriangleInequalityError(f"edge {bad[0]} has the non-positive length {l[bad[0]]}")
     L = side_lengths(tri)
-    slack = L.sum(axis=1, keepdims=True) - 2 * L
-    bad = np.argwhere(slack <= 0)
+    a, b, c = L[:, 0], L[:, 1], L[:, 2]
+    longest = np.maximum(np.maximum(a, b), c)
+    # the longest side is shorter than the other two together (the strict triangle inequality)
+    bad = np.flatnonzero((a + b + c) - longest <= longest)
     if bad.size:
-        f, i = (int(x) for x in bad[0])
+        f = int(bad[0])
+        slack = L[f].sum() - 2 * L[f]
+        i = int(np.argmax(slack <= 0)) if np.any(slack <= 0) else int(np.argmax(L[f]))
         raise TriangleInequalityError(
             f"face {f} has side lengths {tuple(float(x) for x in L[f])}: side {i} is not shorter "
             "than the other two together (the triangle inequality must hold strictly)"
@@ -135,6 +141,12 @@ def _glue_by_keys(keys: np.ndarray):
     """
     order = np.argsort(keys, kind="stable")
     sorted_keys = keys[order]
+    n = keys.size
+    if n % 2 == 0 and n and np.array_equal(sorted_keys[0::2], sorted_keys[1::2]) and np.all(sorted_keys[2::2] != sorted_keys[1:-1:2]):
+        # every key exactly twice (a closed surface): the pairs are consecutive
+        edge = np.empty(n, dtype=np.int64)
+        edge[order] = np.arange(n) >> 1
+        return edge, order.reshape(-1, 2), sorted_keys[0::2], np.full(n // 2, 2)
     is_start = np.empty(keys.size, dtype=bool)
     is_start[:1] = True
     np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=is_start[1:])
@@ -179,8 +191,14 @@ def checked_faces(F, n_vertices: int | None = None):
 def _glue_faces(F: np.ndarray, nv: int):
     """(edge, halfedges, keys) of faces given by vertex triples; keys = i · nv + j, i < j."""
     tail = F.reshape(-1)
-    head = F[:, [1, 2, 0]].reshape(-1)
-    edge, halfedges, keys, count = _glue_by_keys(np.minimum(tail, head) * np.int64(nv) + np.maximum(tail, head))
+    head = np.empty_like(F)
+    head[:, :2] = F[:, 1:]
+    head[:, 2] = F[:, 0]
+    head = head.reshape(-1)
+    lo = np.minimum(tail, head)
+    lo *= np.int64(nv)
+    lo += np.maximum(tail, head)
+    edge, halfedges, keys, count = _glue_by_keys(lo)
     if np.any(count > 2):
         e = int(np.argmax(count > 2))
         raise NonManifoldError(
@@ -228,11 +246,17 @@ def from_mesh(V, F) -> Triangulation:
     Raises as `from_faces`, and `NonFiniteError` for NaN / inf coordinates (naming the vertex).
     """
     V = checked_positions(V)
-    F, nv = checked_faces(F, V.shape[0])
-    edge, halfedges, _ = _glue_faces(F, nv)
-    tail = F.reshape(-1)[halfedges[:, 0]]
-    head = F.reshape(-1)[next_halfedge(halfedges[:, 0])]
-    lengths = np.linalg.norm(V[head] - V[tail], axis=1)
+    F, _ = checked_faces(F, V.shape[0])
+    return from_checked_mesh(V, F)
+
+
+def from_checked_mesh(V: np.ndarray, F: np.ndarray) -> Triangulation:
+    """`from_mesh` for V, F already passed through `checked_positions` / `checked_faces`."""
+    nv = V.shape[0]
+    edge, halfedges, keys = _glue_faces(F, nv)
+    lo = keys // nv
+    d = np.take(V, keys - lo * nv, axis=0) - np.take(V, lo, axis=0)  # take: fancy row indexing is slow
+    lengths = np.sqrt(np.einsum("ij,ij->i", d, d))
     return _validated(Triangulation(F, edge, halfedges, lengths, nv))
 
 
