@@ -66,9 +66,9 @@ def solve_batch(
 
     Each member runs its own Newton iteration (under `vmap` the loop runs until every member
     has converged; finished members stay put), so the result equals a loop of `solve` calls.
-    Both linear-algebra paths batch: `method="sparse"` (KLU, CPU only; vmapped as a loop of
-    factorisations inside the compiled call) and `"dense"` (batched LU, any backend).
-    `"auto"` picks as `solve` does (sparse for declared-local problems on the CPU).
+    Every linear-algebra path batches: `method="sparse"` (KLU, CPU only; vmapped as a loop of
+    factorisations inside the compiled call), `"dense"` (batched LU, any backend) and
+    `"krylov"` (matrix-free, any backend).  `"auto"` picks as `solve` does (`choose_method`).
 
     **Arguments:**
     - `problem`: the template; its `x0`, `fixed`, functions and the unbatched parameters are
@@ -89,13 +89,13 @@ def solve_batch(
     process must pass the same full `params_batch` (it is placed with `jax.device_put`, each
     host keeping its own slice); gather the result where it is needed with
     `jax.experimental.multihost_utils.process_allgather`.  `method="sparse"` runs on CPU
-    hosts only; GPU/TPU hosts use `method="dense"`.
+    hosts only; GPU/TPU hosts use `"dense"` or `"krylov"`.
 
     **Raises:** `ShapeError` (batch axes missing or unequal), `InvalidInputError` (bad
     `method` or `devices`), `ConvergenceError` when `throw` and a member did not converge.
     """
     if method not in METHODS or method == "lbfgs":
-        raise InvalidInputError(f"solve_batch: method must be one of auto, dense, sparse, got {method!r}")
+        raise InvalidInputError(f"solve_batch: method must be one of auto, dense, sparse, krylov, got {method!r}")
     batched, merge = _split_params(problem, params_batch)
     size = _batch_size(batched)
 

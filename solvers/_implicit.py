@@ -2,7 +2,8 @@
 
 At a solution `R(w*(p), p) = 0`, so `K dw*/dp = −∂R/∂p`.  Reverse mode: for a cotangent `w̄`,
 solve `K v = w̄` (K is symmetric) and return `p̄ = −vᵀ ∂R/∂p`, one linear solve with the
-same back end (dense or sparse) that Newton used.  The solver loop itself is never
+same back end (dense, sparse or Krylov) that Newton used; the back end is an argument
+(a pytree of index arrays) with no derivative.  The solver loop itself is never
 differentiated.
 """
 
@@ -18,18 +19,18 @@ from ._kkt import KKT
 ADJOINT_MU = 1e-13  # relative regularisation of the adjoint solve (singular K under symmetry)
 
 
-@partial(jax.custom_vjp, nondiff_argnums=(0, 1))
+@partial(jax.custom_vjp, nondiff_argnums=(0,))
 def implicit_solution(spec, algebra, w_star, z0, params):
     """Identity on `w_star`; its derivative is that of the KKT point as a function of (z0, params)."""
     return w_star
 
 
 def _fwd(spec, algebra, w_star, z0, params):
-    return w_star, (w_star, z0, params)
+    return w_star, (algebra, w_star, z0, params)
 
 
-def _bwd(spec, algebra, residuals, w_bar):
-    w_star, z0, params = residuals
+def _bwd(spec, residuals, w_bar):
+    algebra, w_star, z0, params = residuals
     kkt = KKT(spec, z0, params)
     v = algebra.solve(kkt, w_star, ADJOINT_MU, w_bar)
 
@@ -38,7 +39,7 @@ def _bwd(spec, algebra, residuals, w_bar):
 
     _, vjp = jax.vjp(R_of, z0, params)
     z0_bar, params_bar = vjp(-v)
-    return jnp.zeros_like(w_star), z0_bar, params_bar
+    return None, jnp.zeros_like(w_star), z0_bar, params_bar
 
 
 implicit_solution.defvjp(_fwd, _bwd)

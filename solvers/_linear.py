@@ -16,15 +16,13 @@ Two interchangeable back ends, static and hashable, with the methods
 Evaluating the second derivatives once per step (not again for the LM fallback and its model)
 keeps the compiled Newton loop small: compile time is dominated by the size of the traced
 graph, and the per-cell Hessians are its largest part.
-The sparse back end's index arrays enter the compiled solver as constants (it is a static
-argument of `jit`): XLA's gathers and scatters with constant indices are ~10× faster than
-with traced ones.
+The back ends are pytrees: the sparse one's index arrays are arguments of the compiled solver
+(`_sparse.index_arrays`), its pattern and KLU analysis static data.
 - `DenseAlgebra`: `K` by forward-over-reverse autodiff, LU by `jax.scipy.linalg.lu_factor` (not
   lineax's LU, whose structure check fails inside `jax.shard_map`: `solve_batch`).  For n ≲ 2,000.
 - `SparseAlgebra`: `K` assembled from the per-cell Hessian blocks of a problem declared with
   `dg.local_sum` / `dg.local_map`, factorised by KLU (klujax), inside `jit`, `vmap`-able.
-  Its LM step solves the augmented system `[[I, K], [Kᵀ, −ν I]] (s, d) = (−R, 0)`, which
-  keeps K's sparsity.
+  Its LM step is one complex solve with `K + i√ν I`, on K's own pattern and KLU analysis.
 
 `identity_hessian=True` replaces `∇²L` by the identity: the system then gives the least-squares
 multipliers `argmin_λ |∇E − Jᵀλ|` used to start Newton.
@@ -36,7 +34,7 @@ import jax
 import jax.numpy as jnp
 
 from ._kkt import KKT
-from ._sparse import SparsePattern, cell_blocks
+from ._sparse import SPLIT_ARRAYS, PatternKey, SparsePattern, index_arrays, kkt_values
 
 MU_FLOOR = 1e-300
 
@@ -55,14 +53,16 @@ class _Algebra:
         return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
 
 
+@jax.tree_util.register_pytree_node_class
 class DenseAlgebra(_Algebra):
-    """Dense KKT matrix by `jax.hessian` of the Lagrangian; LU solve."""
+    """Dense KKT matrix by `jax.hessian` of the Lagrangian; LU solve.  A pytree without leaves."""
 
-    def __hash__(self):
-        return hash(DenseAlgebra)
+    def tree_flatten(self):
+        return (), None
 
-    def __eq__(self, other):
-        return isinstance(other, DenseAlgebra)
+    @classmethod
+    def tree_unflatten(cls, aux, children):
+        return cls()
 
     def matrix(self, kkt: KKT, w, identity_hessian=False):
         n, m = kkt.spec.n, kkt.spec.m
@@ -101,78 +101,76 @@ def _klu_solve(rows, cols, values, b, symbolic):
 
     handle = jnp.asarray(symbolic.raw, dtype=jnp.uint64)
     rhs = b.reshape(1, b.shape[0], -1)  # (n_lhs = 1, n_col, n_rhs)
-    x = klujax.solve_with_symbol_f64.bind(
+    solve = klujax.solve_with_symbol_c128 if jnp.iscomplexobj(values) else klujax.solve_with_symbol_f64
+    x = solve.bind(
         jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], rhs, handle
     )
     return x.reshape(b.shape)
 
 
-def _bordered_solve(split, values, b):
-    """Solve `[[A, B], [Bᵗ, C]] x = b` through the Schur complement of the border (`Bordered`)."""
+def _bordered_solve(split, index: dict, values, b):
+    """Solve `[[A, B], [Bᵗ, C]] x = b` through the Schur complement of the border (`Bordered`);
+    `index` holds its arrays (`split_*`), `split` the sizes and KLU's analysis of A."""
+    ix = {name: index[f"split_{name}"] for name in SPLIT_ARRAYS}
     n_in, p = len(split.interior), len(split.border)
-    B = jnp.zeros((n_in, p)).at[split.b_rows, split.b_cols].add(values[split.take_b])
-    Bt = jnp.zeros((p, n_in)).at[split.bt_rows, split.bt_cols].add(values[split.take_bt])
-    C = jnp.zeros((p, p)).at[split.c_rows, split.c_cols].add(values[split.take_c])
-    rhs = jnp.concatenate([b[split.interior][:, None], B], axis=1)
-    Y = _klu_solve(split.a_rows, split.a_cols, values[split.take_a], rhs, split.symbolic())
+    B = jnp.zeros((n_in, p), values.dtype).at[ix["b_rows"], ix["b_cols"]].add(values[ix["take_b"]])
+    Bt = jnp.zeros((p, n_in), values.dtype).at[ix["bt_rows"], ix["bt_cols"]].add(values[ix["take_bt"]])
+    C = jnp.zeros((p, p), values.dtype).at[ix["c_rows"], ix["c_cols"]].add(values[ix["take_c"]])
+    rhs = jnp.concatenate([b[ix["interior"]][:, None], B], axis=1)
+    Y = _klu_solve(ix["a_rows"], ix["a_cols"], values[ix["take_a"]], rhs, split.symbolic())
     schur = C - Bt @ Y[:, 1:]
-    x_border = jnp.linalg.solve(schur, b[split.border] - Bt @ Y[:, 0])
+    x_border = jnp.linalg.solve(schur, b[ix["border"]] - Bt @ Y[:, 0])
     x_interior = Y[:, 0] - Y[:, 1:] @ x_border
-    return jnp.zeros_like(b).at[split.interior].set(x_interior).at[split.border].set(x_border)
+    return jnp.zeros(b.shape, values.dtype).at[ix["interior"]].set(x_interior).at[ix["border"]].set(x_border)
 
 
+@jax.tree_util.register_pytree_node_class
 class SparseAlgebra(_Algebra):
-    """Sparse KKT matrix assembled from local blocks; KLU solve (klujax)."""
+    """Sparse KKT matrix assembled from local blocks; KLU solve (klujax).
 
-    def __init__(self, pattern: SparsePattern):
+    A pytree whose leaves are the pattern's index arrays (`index_arrays`) and whose static
+    part is the pattern (compared by structure, `PatternKey`): the compiled solver takes the
+    arrays as arguments.
+    """
+
+    def __init__(self, pattern: SparsePattern, index: dict | None = None):
         self.pattern = pattern
-        # KLU's analyses, made here, outside any trace
-        for augmented in (False, True):
-            if pattern.split(augmented) is None:
-                pattern.symbolic(augmented)
+        if index is None:
+            # KLU's analysis, made here, outside any trace
+            if pattern.split() is None:
+                pattern.symbolic()
+            index = index_arrays(pattern)
+        self.index = index
 
-    # Equal by the problem structure the pattern was built from (functions, stencils, layout),
-    # so that every problem declared alike (e.g. each `elastica.clamped(n, ...)` call) reuses
-    # one compiled solver.  jit's cache keeps the first algebra, and with it the KLU analyses
-    # its compiled code refers to, alive.
-    def __hash__(self):
-        return hash(self.pattern.key)
+    def tree_flatten(self):
+        names = tuple(sorted(self.index))
+        return tuple(self.index[k] for k in names), (PatternKey(self.pattern), names)
 
-    def __eq__(self, other):
-        return isinstance(other, SparseAlgebra) and other.pattern.key == self.pattern.key
+    @classmethod
+    def tree_unflatten(cls, aux, children):
+        key, names = aux
+        return cls(key.pattern, dict(zip(names, children)))
 
     def matrix(self, kkt: KKT, w, identity_hessian=False):
         """Coalesced COO values of K (K's Hessian block replaced by I if asked)."""
-        n, m, p = kkt.spec.n, kkt.spec.m, self.pattern
-        hess, jac = cell_blocks(p, kkt, w, identity_hessian)
-        raw = jnp.concatenate([hess, -jac])
-        # a concatenation, not `zeros.at[:n].add`: XLA constant-folds that scatter (seconds at 10⁵)
-        diag = jnp.concatenate([jnp.full((n,), 1.0 if identity_hessian else 0.0), jnp.zeros((m,))])
-        values = jnp.concatenate([raw[p.source], diag])
-        return jax.ops.segment_sum(values, p.target, num_segments=p.nnz)
+        return kkt_values(self.pattern, self.index, kkt, w, identity_hessian)
 
     def factor_matrix(self, kkt: KKT, K, mu_rel):
-        n, m, p = kkt.spec.n, kkt.spec.m, self.pattern
+        n, m = kkt.spec.n, kkt.spec.m
         scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
-        diagonal = p.target[p.source.shape[0]:]  # where the n + m diagonal entries were summed
-        return K.at[diagonal].add(_regularisation(n, m, jnp.maximum(mu_rel, MU_FLOOR) * scale))
+        return K.at[self.index["diagonal"]].add(_regularisation(n, m, jnp.maximum(mu_rel, MU_FLOOR) * scale))
 
     def apply(self, fac, b):
         split = self.pattern.split()
         if split is not None:
-            return _bordered_solve(split, fac, b)
-        return _klu_solve(self.pattern.rows, self.pattern.cols, fac, b, self.pattern.symbolic())
+            return _bordered_solve(split, self.index, fac, b)
+        return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.pattern.symbolic())
 
     def matvec(self, K, v):
-        p = self.pattern
-        return jax.ops.segment_sum(K * v[p.cols], p.rows, num_segments=v.shape[0])
+        return jax.ops.segment_sum(K * v[self.index["cols"]], self.index["rows"], num_segments=v.shape[0])
 
     def lm_solve_matrix(self, K, nu, R):
-        size = R.shape[0]
-        aug = jnp.concatenate([jnp.ones((size,)), K, K, jnp.full((size,), -nu)])
-        rhs = jnp.concatenate([-R, jnp.zeros_like(R)])
-        rows, cols, order = self.pattern.augmented()
-        split = self.pattern.split(augmented=True)
-        if split is not None:
-            return _bordered_solve(split, aug[order], rhs)[size:]
-        return _klu_solve(rows, cols, aug[order], rhs, self.pattern.symbolic(augmented=True))[size:]
+        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric: `(K + isI)⁻¹ = (K − isI)(K² + s²I)⁻¹`),
+        one complex KLU solve on K's own pattern and analysis, with smallest singular value ≥ √ν."""
+        shifted = K.astype(jnp.complex128).at[self.index["diagonal"]].add(1j * jnp.sqrt(nu))
+        return -jnp.real(self.apply(shifted, R.astype(jnp.complex128)))

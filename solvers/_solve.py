@@ -15,11 +15,12 @@ from ddgjax.problem import Problem, validate_multipliers
 from ._first_order import augmented_lagrangian
 from ._implicit import implicit_solution
 from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
+from ._krylov import KrylovAlgebra
 from ._linear import DenseAlgebra, SparseAlgebra
 from ._newton import CONVERGED, NONFINITE, STATUS_TEXT, newton
 from ._sparse import cached_pattern
 
-METHODS = ("auto", "dense", "sparse", "lbfgs")
+METHODS = ("auto", "dense", "sparse", "krylov", "lbfgs")
 FIRST_ORDER_OUTER = 50
 
 
@@ -46,21 +47,41 @@ class Solution(NamedTuple):
     status: jax.Array
 
 
+DENSE_MAX = 2000  # unknowns + multipliers: dense LU beyond this costs seconds and gigabytes
+
+
+def choose_method(spec: Spec, backend: str) -> str:
+    """The linear algebra `method="auto"` uses, by size and backend.
+
+    - `"sparse"` (KLU) for a problem declared local on the CPU: there it beats dense LU at every
+      size we measured (N = 10²: 1.0 vs 2.6 ms, `benchmarks/solver.py`);
+    - `"dense"` when N = n + m ≤ `DENSE_MAX` otherwise (one LU on an accelerator is fast);
+    - `"krylov"` for larger problems that are not local-on-CPU (KLU runs on the CPU only, and
+      dense LU does not fit): matrix-free, inside `jit` on any backend.
+    """
+    if spec.is_local and backend == "cpu":
+        return "sparse"
+    if spec.n + spec.m <= DENSE_MAX:
+        return "dense"
+    return "krylov"
+
+
 def _choose_algebra(problem: Problem, spec: Spec, method: str):
     if method == "sparse" and not spec.is_local:
         raise InvalidInputError(
             "method='sparse' needs an energy declared with dg.local_sum (and constraints with "
             "dg.local_map / dg.local_sum / dg.concat) over a single array of unknowns"
         )
-    # KLU runs on the CPU; there it beats dense LU at every size we measured (N = 10²: 1.0 vs
-    # 2.6 ms, benchmarks/solver.py), so a declared-local problem always takes the sparse path.
-    sparse = method == "sparse" or (method == "auto" and spec.is_local and jax.default_backend() == "cpu")
-    if sparse:
+    if method == "auto":
+        method = choose_method(spec, jax.default_backend())
+    if method == "sparse":
         return SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
+    if method == "krylov":
+        return KrylovAlgebra(cached_pattern(spec, problem.x0, problem.params) if spec.is_local else None)
     return DenseAlgebra()
 
 
-@partial(jax.jit, static_argnames=("spec", "algebra", "tol", "max_steps", "first_order", "newton_phase"))
+@partial(jax.jit, static_argnames=("spec", "tol", "max_steps", "first_order", "newton_phase"))
 def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
     z0_, params_ = jax.lax.stop_gradient((z0, params))
     kkt = KKT(spec, z0_, params_)
@@ -85,7 +106,7 @@ def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, firs
         finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
         status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
 
-    w = implicit_solution(spec, algebra, w, z0, params)
+    w = implicit_solution(spec, jax.lax.stop_gradient(algebra), w, z0, params)
     kkt_diff = KKT(spec, z0, params)
     u, lam = kkt_diff.split(w)
     x = kkt_diff.x(u)
@@ -114,9 +135,11 @@ def solve(
     - `tol`: stop when the scaled max-norm KKT residual is `<= tol` (see `Problem.residual_scale`).
     - `max_steps`: Newton steps (outer augmented-Lagrangian steps for `method="lbfgs"`).
     - `method`: `"dense"` (LU, n ≲ 2,000), `"sparse"` (KLU on the KKT matrix assembled from a
-      locality declaration, `dg.local_sum`), `"lbfgs"` (augmented Lagrangian with jaxopt
-      L-BFGS inner solves: minimisation only, first-order), or `"auto"` (sparse when the
-      problem is declared local and the backend is the CPU, else dense).
+      locality declaration, `dg.local_sum`; CPU), `"krylov"` (matrix-free Newton–MINRES on the
+      constraints' tangent space, inside `jit` on any backend: `solvers/_krylov.py`),
+      `"lbfgs"` (augmented Lagrangian with jaxopt L-BFGS inner solves: minimisation only,
+      first-order), or `"auto"` (`choose_method`: sparse for a problem declared local on the
+      CPU, else dense up to N = n + m = 2,000 unknowns and multipliers, else Krylov).
     - `throw`: raise `ConvergenceError` when not converged (only outside `jit`/`vmap`; inside
       them check `Solution.converged`).
     - `multipliers0`: starting multipliers (default: least squares `argmin |∇E − Jᵀλ|` at x0).

@@ -47,7 +47,7 @@ class SparsePattern:
     rows: np.ndarray  # (nnz,) int32, coalesced COO rows of the KKT matrix
     cols: np.ndarray  # (nnz,) int32
     source: np.ndarray  # (n_raw,) int32: index into the raw block values
-    target: np.ndarray  # (n_raw + n + m,) int32: coalesced entry of each raw value and diagonal
+    target: np.ndarray  # (n_raw + n + m,) int32: coalesced entry of each raw value, then of the diagonal
     coupled: np.ndarray  # KKT indices of the multipliers of global sums (e.g. a chord)
     key: tuple = ()  # the Spec key it was built from: equal keys give interchangeable patterns
 
@@ -55,48 +55,30 @@ class SparsePattern:
     def nnz(self) -> int:
         return int(self.rows.size)
 
-    def split(self, augmented: bool = False) -> Bordered | None:
-        """The KKT (or LM) matrix split at the coupled multipliers; None if there are none."""
+    def split(self) -> Bordered | None:
+        """The KKT matrix split at the coupled multipliers; None if there are none."""
         if not self.coupled.size:
             return None
-        key = "_split_aug" if augmented else "_split"
-        if key not in self.__dict__:
-            size = self.n + self.m
-            if augmented:
-                rows, cols = self.augmented()[:2]
-                self.__dict__[key] = bordered(rows, cols, np.concatenate([self.coupled, size + self.coupled]), 2 * size)
-            else:
-                self.__dict__[key] = bordered(self.rows, self.cols, self.coupled, size)
-            self.__dict__[key].symbolic()
-        return self.__dict__[key]
+        if "_split" not in self.__dict__:
+            self.__dict__["_split"] = bordered(self.rows, self.cols, self.coupled, self.n + self.m)
+            self.__dict__["_split"].symbolic()
+        return self.__dict__["_split"]
 
-    def symbolic(self, augmented: bool = False):
-        """KLU's symbolic analysis (ordering) of the KKT or LM matrix, made once and kept here.
+    def symbolic(self):
+        """KLU's symbolic analysis (ordering) of the KKT matrix, made once and kept here.
 
         Made outside any trace and kept alive by this pattern, which `jit`'s cache holds
-        through the static `SparseAlgebra`; every factorisation then skips the ordering.
+        through the static `SparseAlgebra`; every factorisation then skips the ordering.  The
+        analysis depends on the pattern only, so the complex Levenberg–Marquardt solves reuse it.
         """
-        key = "_symbolic_aug" if augmented else "_symbolic"
-        if key not in self.__dict__:
-            rows, cols = self.augmented()[:2] if augmented else (self.rows, self.cols)
-            size = (self.n + self.m) * (2 if augmented else 1)
-            self.__dict__[key] = _analyze(rows, cols, size)
-        return self.__dict__[key]
+        if "_symbolic" not in self.__dict__:
+            self.__dict__["_symbolic"] = _analyze(self.rows, self.cols, self.n + self.m)
+        return self.__dict__["_symbolic"]
 
-    def augmented(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Sorted COO indices of the Levenberg–Marquardt matrix `[[I, K], [Kᵀ, −νI]]`.
-
-        Returns `(rows, cols, order)`: the values in the order (1…, K, K, −ν…) go to
-        `values[order]`.
-        """
-        if "_augmented" not in self.__dict__:
-            size = self.n + self.m
-            diag = np.arange(size)
-            rows = np.concatenate([diag, self.rows, size + self.cols, size + diag])
-            cols = np.concatenate([diag, size + self.cols, self.rows, size + diag])
-            order = np.lexsort((cols, rows))
-            self.__dict__["_augmented"] = (rows[order].astype(np.int32), cols[order].astype(np.int32), order)
-        return self.__dict__["_augmented"]
+    def blocks(self) -> tuple[np.ndarray, np.ndarray]:
+        """Value indices `(H entries, −J entries)` of the coalesced KKT matrix."""
+        n = self.n
+        return np.flatnonzero((self.rows < n) & (self.cols < n)), np.flatnonzero((self.rows >= n) & (self.cols < n))
 
 
 @dataclass(frozen=True, eq=False)
@@ -283,3 +265,52 @@ def cell_blocks(pattern: SparsePattern, kkt: KKT, w, identity_hessian: bool):
         hess = jnp.concatenate(pieces)
     jac = [_cell_jacobians(tp.term, x, kkt.params) for tp in pattern.constraint_terms]
     return hess, (jnp.concatenate(jac) if jac else jnp.zeros((0,), dtype=w.dtype))
+
+
+def kkt_values(pattern: SparsePattern, index: dict, kkt: KKT, w, identity_hessian: bool = False):
+    """Coalesced COO values (at `pattern.rows`, `pattern.cols`) of K at w (∇²L replaced by I if asked);
+    `index = index_arrays(pattern)`, or the same arrays traced."""
+    n, m = pattern.n, pattern.m
+    hess, jac = cell_blocks(pattern, kkt, w, identity_hessian)
+    raw = jnp.concatenate([hess, -jac])
+    # a concatenation, not `zeros.at[:n].add`: XLA constant-folds that scatter (seconds at 10⁵)
+    diag = jnp.concatenate([jnp.full((n,), 1.0 if identity_hessian else 0.0), jnp.zeros((m,))])
+    values = jnp.concatenate([raw[index["source"]], diag])
+    return jax.ops.segment_sum(values, index["target"], num_segments=pattern.nnz)
+
+
+SPLIT_ARRAYS = ("interior", "border", "a_rows", "a_cols", "take_a", "b_rows", "b_cols", "take_b",
+                "bt_rows", "bt_cols", "take_bt", "c_rows", "c_cols", "take_c")
+
+
+def index_arrays(pattern: SparsePattern) -> dict:
+    """The pattern's index arrays as int32 device arrays, made once and kept on the pattern.
+
+    The solvers take them as *arguments* of the compiled solver, not as constants compiled into
+    it: at 10⁵ elastica edges constants of this size (~200 MB) made XLA's compile take 1.3 GB
+    more memory, held for the executable's lifetime; gathers with traced indices are as fast
+    (7.8·10⁶-entry gather + segment sum: 0.11 s either way).
+    """
+    if "_index" not in pattern.__dict__:
+        h_at, j_at = pattern.blocks()
+        arrays = {"source": pattern.source, "target": pattern.target, "rows": pattern.rows, "cols": pattern.cols,
+                  "diagonal": pattern.target[pattern.source.shape[0]:], "h_at": h_at, "j_at": j_at}
+        split = pattern.split()
+        if split is not None:
+            arrays.update({f"split_{name}": getattr(split, name) for name in SPLIT_ARRAYS})
+        pattern.__dict__["_index"] = {k: jnp.asarray(np.asarray(v, dtype=np.int32)) for k, v in arrays.items()}
+    return pattern.__dict__["_index"]
+
+
+class PatternKey:
+    """A pattern as static data of a pytree: equal (and hashing) by the problem structure it was
+    built from, so that every problem declared alike reuses one compiled solver."""
+
+    def __init__(self, pattern: SparsePattern):
+        self.pattern = pattern
+
+    def __hash__(self):
+        return hash(self.pattern.key)
+
+    def __eq__(self, other):
+        return isinstance(other, PatternKey) and other.pattern.key == self.pattern.key

@@ -39,6 +39,7 @@ def smooth(rods):
     return kirchhoff.from_discrete(*rods[32])
 
 
+@pytest.mark.slow  # the shooting reference compiles for ~50 s on 2 cores (make test-all)
 def test_shooting_reference_meets_the_clamps(smooth):
     Phi, gamma = kirchhoff.sample(smooth, jnp.array([0.0, 1.0]))
     assert float(jnp.max(jnp.abs(gamma[1] - CHORD))) <= 1e-10
@@ -46,6 +47,7 @@ def test_shooting_reference_meets_the_clamps(smooth):
     assert abs(kirchhoff.torsion(smooth)) > 0.5  # a genuinely twisted rod
 
 
+@pytest.mark.slow  # the shooting reference compiles for ~50 s on 2 cores (make test-all)
 def test_vertex_clamped_discrete_rods_converge_at_order_two(rods, smooth):
     """Thm 3.13: centreline, load a and torsion τ of the discrete rods converge at O(h²)
     (n = 16, 32 here; n = 16 … 256 in the slow study)."""

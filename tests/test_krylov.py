@@ -1,0 +1,103 @@
+"""Issue 9: the matrix-free Newton–Krylov path (`method="krylov"`, `solvers/_krylov.py`) and the
+`method="auto"` rule.  Agreement of sparse, Krylov and dense solves on the catalogue is in
+`test_scale.py`."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from solvers import solve, solve_batch
+from solvers._krylov import minres
+from solvers._solve import DENSE_MAX, choose_method
+from solvers.problems import random_symmetric, rayleigh
+
+
+def test_minres_solves_symmetric_indefinite_systems_to_round_off():
+    """MINRES with a symmetric positive definite preconditioner on an indefinite A: |Ax − b| small."""
+    rng = np.random.default_rng(0)
+    Q = np.linalg.qr(rng.normal(size=(40, 40)))[0]
+    eig = np.concatenate([-np.logspace(0, 3, 15), np.logspace(-1, 2, 25)])  # indefinite, cond 10⁴
+    A = jnp.asarray(Q @ np.diag(eig) @ Q.T)
+    b = jnp.asarray(rng.normal(size=40))
+    d = jnp.asarray(rng.uniform(0.5, 2.0, 40))
+    x, iterations, rel = jax.jit(lambda b: minres(lambda v: A @ v, b, lambda r: r / d, rtol=1e-13, maxiter=200))(b)
+    exact = np.linalg.solve(np.asarray(A), np.asarray(b))
+    assert float(np.max(np.abs(np.asarray(x) - exact))) <= 1e-10 * np.max(np.abs(exact))
+    # exact arithmetic needs ≤ 40 iterations; in float64 the lost orthogonality costs more (scipy
+    # minres: 129 on this system)
+    assert float(rel) <= 1e-13 and 0 < int(iterations) <= 160
+
+
+def test_krylov_finds_a_saddle_point_of_a_non_local_problem():
+    """The reduced Hessian at a middle eigenvector is indefinite: MINRES, not CG, on the tangent
+    space of the sphere (no locality declared: products by autodiff, no preconditioner)."""
+    A = np.diag([1.0, 2.0, 3.0, 4.0, 5.0])
+    sol = solve(rayleigh(A, np.array([0.05, 0.1, 1.0, -0.08, 0.02])), method="krylov")
+    assert float(sol.residual) <= 1e-10
+    assert abs(float(sol.multipliers[0]) - 3.0) <= 1e-12
+
+
+def test_krylov_quadratic_convergence_and_agreement_with_dense():
+    A = random_symmetric(20, 5)
+    problem = rayleigh(A, np.linalg.eigh(A)[1][:, 3] + 0.05)
+    k, d = solve(problem, method="krylov"), solve(problem, method="dense")
+    h = np.asarray(k.history)
+    assert h[-1] <= 1e-10 and h[-1] <= 10 * h[-2] ** 2 * max(1.0, 1 / h[-3])
+    assert float(jnp.max(jnp.abs(k.x - d.x))) <= 1e-10
+    assert float(jnp.max(jnp.abs(k.multipliers - d.multipliers))) <= 1e-10
+
+
+def _elastica(n=9):
+    from energies import elastica
+
+    return elastica.clamped(n, chord=(0.5, 0.3, 0.1), t_start=(1, 0, 0), t_end=(0, 1, 0), clamp="vertex")
+
+
+def test_krylov_derivatives():
+    """Implicit differentiation through the Krylov solve equals the dense one."""
+    problem = _elastica()
+
+    def energy_of(chord, method):
+        return solve(problem.with_params({**problem.params, "chord": chord}), method=method).energy
+
+    chord = jnp.asarray(problem.params["chord"])
+    g_k = jax.grad(lambda c: energy_of(c, "krylov"))(chord)
+    g_d = jax.grad(lambda c: energy_of(c, "dense"))(chord)
+    assert float(jnp.max(jnp.abs(g_k - g_d))) <= 1e-9 * float(jnp.max(jnp.abs(g_d)))
+
+
+@pytest.mark.slow
+def test_krylov_batches():
+    """A vmapped batch equals single solves (the whole Krylov solver runs inside jit and vmap)."""
+    problem = _elastica()
+    chord = jnp.asarray(problem.params["chord"])
+    chords = jnp.stack([chord * (1 - 0.05 * k) for k in range(3)])
+    batch = solve_batch(problem, {"chord": chords}, method="krylov")
+    for k in range(3):
+        single = solve(problem.with_params({**problem.params, "chord": chords[k]}), method="dense")
+        assert float(jnp.max(jnp.abs(batch.x[k] - single.x))) <= 1e-10
+
+
+class _FakeSpec:
+    """What `choose_method` reads of a `Spec`."""
+
+    def __init__(self, n, m, local):
+        self.n, self.m, self.is_local = n, m, local
+
+
+@pytest.mark.parametrize(
+    "n, m, local, backend, expected",
+    [
+        (10, 2, True, "cpu", "sparse"),
+        (10**5, 10**5, True, "cpu", "sparse"),
+        (10, 2, True, "gpu", "dense"),
+        (DENSE_MAX - 2, 2, True, "gpu", "dense"),
+        (DENSE_MAX, 1, True, "gpu", "krylov"),
+        (10**5, 10**5, True, "tpu", "krylov"),
+        (100, 0, False, "cpu", "dense"),
+        (10**4, 10, False, "cpu", "krylov"),
+    ],
+)
+def test_auto_picks_method_by_size_and_backend(n, m, local, backend, expected):
+    assert choose_method(_FakeSpec(n, m, local), backend) == expected
