@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 from jaxtyping import Array, Float
+from scipy.optimize import brentq
 
 import ddgjax as dg
 from ddgjax.errors import ConvergenceError, InvalidInputError
@@ -41,7 +42,7 @@ from ddgjax.laplace import (
     triangle_area,
 )
 
-__all__ = ["METHODS", "face_area", "mesh_boundary", "minimal_surface", "pinkall_polthier_step", "simplicial"]
+__all__ = ["METHODS", "catenoid_neck", "face_area", "mesh_boundary", "minimal_surface", "neck_radius", "pinkall_polthier_step", "simplicial"]
 
 METHODS = ("cotan", "newton", "delaunay")
 
@@ -166,3 +167,15 @@ def minimal_surface(V, F, boundary=None, *, method: str = "cotan", tol: float = 
             residual=info["residual"], steps=info["iterations"],
         )
     return V_min, F, info
+
+
+def catenoid_neck(R: float = 1.0, H: float = 0.5) -> float:
+    """The neck radius c of the stable catenoid r(z) = c cosh(z/c) through the circles of radius R
+    at z = ±H: the larger root of c cosh(H/c) = R (the smaller one is the unstable catenoid)."""
+    fold = brentq(lambda c: np.tanh(H / c) - c / H, 1e-3 * H, H)  # c cosh(H/c) is least here
+    return brentq(lambda c: c * np.cosh(H / c) - R, fold, R)
+
+
+def neck_radius(V) -> float:
+    """min over the vertices of the distance to the z-axis."""
+    return float(np.min(np.linalg.norm(np.asarray(V)[:, :2], axis=1)))

@@ -12,9 +12,8 @@ from __future__ import annotations
 import numpy as np
 from _common import output_dir, run
 
-from ddgjax import intrinsic
+from ddgjax import intrinsic, mesh
 from ddgjax.plot import save_figure
-from ddgjax.verify.checks._surfaces import stretched_sphere, tall_dome
 
 
 def _pyplot():
@@ -44,7 +43,7 @@ def draw_edges(ax, tri, V, title: str):
 
 
 def ellipsoid(level: int, path):
-    V, F = stretched_sphere(level)
+    V, F = mesh.builtin.stretched_sphere(level)
     start = intrinsic.from_mesh(V, F)
     result = intrinsic.flip_to_delaunay(start)
     h = result.harmonic_index
@@ -67,7 +66,7 @@ def ellipsoid(level: int, path):
 
 def main(out=None, tiny: bool = False):
     out = output_dir(out)
-    V, F, _ = tall_dome(0, n_inner=60 if tiny else 300, height=0.0)  # a flat disk with skinny triangles
+    V, F, _ = mesh.builtin.tall_dome(0, n_inner=60 if tiny else 300, height=0.0)  # a flat disk with skinny triangles
     result = intrinsic.plot.before_after(V, F, out / "intrinsic_delaunay_disk.png")
     print(f"flat disk: {result.n_flips} flips to the planar Delaunay triangulation")
     return [ellipsoid(2 if tiny else 3, out / "intrinsic_delaunay_ellipsoid.png"), out / "intrinsic_delaunay_disk.png"]

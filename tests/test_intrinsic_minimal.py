@@ -8,7 +8,6 @@ from scipy.spatial import Delaunay
 import ddgjax as dg
 from ddgjax.intrinsic import minimal
 from ddgjax.intrinsic import plot as iplot
-from ddgjax.verify.checks._surfaces import tall_dome as _tall_dome  # Fig 7.26's start
 
 
 def _cotan_iteration(V, F, boundary, budget):
@@ -25,7 +24,7 @@ def _cotan_iteration(V, F, boundary, budget):
 def test_fig_6_5_cotan_iteration_here_agrees_with_energies_area():
     """`harmonic_iteration(flip=False)` is Fig 6.5: the same iterates as energies.area."""
     area = pytest.importorskip("energies.area")
-    V, F, boundary = _tall_dome(0, n_inner=40, m=16, stretch=1.0, height=0.5)
+    V, F, boundary = dg.mesh.builtin.tall_dome(0, n_inner=40, m=16, stretch=1.0, height=0.5)
     W1, _, info1 = minimal.harmonic_iteration(V, F, boundary, flip=False, max_iter=3)
     W2, _, info2 = area.minimal_surface(V, F, boundary, method="cotan", max_iter=3, throw=False)
     np.testing.assert_allclose(W1, W2, atol=1e-12)
@@ -34,7 +33,7 @@ def test_fig_6_5_cotan_iteration_here_agrees_with_energies_area():
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_fig_7_26_cotan_iteration_fails_delaunay_iteration_converges(seed):
-    V, F, boundary = _tall_dome(seed)
+    V, F, boundary = dg.mesh.builtin.tall_dome(seed)
     assert not _cotan_iteration(V, F, boundary, budget=30)
     W, F1, info = minimal.minimal_surface_delaunay(V, F, boundary, tol=1e-9, max_iter=30)
     assert info["converged"] and info["iterations"] <= 5
@@ -59,7 +58,7 @@ def test_fig_7_26_cotan_iteration_fails_delaunay_iteration_converges(seed):
 def test_remark_7_10_maximum_principle_at_every_vertex():
     """Every free vertex is a convex combination of its Delaunay neighbours (Prop 6.8): the
     weights are ≥ 0 and reproduce the vertex."""
-    V, F, boundary = _tall_dome(2)
+    V, F, boundary = dg.mesh.builtin.tall_dome(2)
     W, _, info = minimal.minimal_surface_delaunay(V, F, boundary)
     tri = info["triangulation"]
     L = dg.intrinsic.cotan_laplacian(tri).tocsr()
@@ -75,7 +74,7 @@ def test_remark_7_10_maximum_principle_at_every_vertex():
 
 
 def test_minimal_surface_bad_boundary_index():
-    V, F, _ = _tall_dome(0, n_inner=20, m=8)
+    V, F, _ = dg.mesh.builtin.tall_dome(0, n_inner=20, m=8)
     with pytest.raises(dg.errors.MeshError, match="boundary vertex index 999"):
         minimal.minimal_surface_delaunay(V, F, [0, 999])
 

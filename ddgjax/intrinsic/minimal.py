@@ -18,12 +18,13 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..errors import ConvergenceError, DDGError, InvalidInputError, MeshError
+from ..mesh.builtin import tall_dome
 from .delaunay import DELAUNAY_TOL, flip_to_delaunay
 from .geometry import triangle_area
 from .laplace_beltrami import cotan_laplacian
 from .triangulation import Triangulation, boundary_vertices, from_mesh, side_lengths
 
-__all__ = ["harmonic_iteration", "interior_residual", "minimal_surface_delaunay"]
+__all__ = ["fig_7_26", "harmonic_iteration", "interior_residual", "minimal_surface_delaunay"]
 
 
 def _boundary_mask(boundary, n: int) -> np.ndarray:
@@ -123,3 +124,13 @@ def minimal_surface_delaunay(V, F, boundary=None, *, tol: float = 1e-10, max_ite
     """
     return harmonic_iteration(V, F, boundary, flip=True, tol=tol, max_iter=max_iter,
                               delaunay_tol=delaunay_tol, throw=throw)
+
+
+def fig_7_26(seed: int = 0, budget: int = 30, **dome):
+    """Fig 7.26 on `mesh.tall_dome(seed, **dome)`: `(V, F, boundary, cotan, narrow)` with `cotan` and
+    `narrow` the `(V, F, info)` of `intrinsic.minimal.harmonic_iteration` without flips (Fig 6.5,
+    which ends a run whose iterate degenerates) and with flips (Fig 7.23), `budget` iterations."""
+    V, F, boundary = tall_dome(seed, **dome)
+    cotan = harmonic_iteration(V, F, boundary, flip=False, tol=1e-9, max_iter=budget)
+    narrow = harmonic_iteration(V, F, boundary, flip=True, tol=1e-9, max_iter=budget)
+    return V, F, boundary, cotan, narrow

@@ -13,7 +13,7 @@ from ..errors import ShapeError
 from .delaunay import DELAUNAY_TOL, delaunay_edges, flip_to_delaunay
 from .triangulation import Triangulation, from_mesh
 
-__all__ = ["before_after", "triangulation"]
+__all__ = ["before_after", "draw_fig_7_26", "triangulation"]
 
 
 def _pyplot():
@@ -64,3 +64,32 @@ def before_after(V, F, path, *, tol: float = DELAUNAY_TOL):
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return result
+
+
+def draw_fig_7_26(path, V, F, cotan, narrow):
+    """Three surfaces (the start, the last Fig 6.5 iterate, the Fig 7.23 result) above the two
+    residual histories; saved to `path` (PNG)."""
+    plt = _pyplot()
+    fig = plt.figure(figsize=(12.0, 7.5))
+    panels = ((V, F, "start (skinny triangles)"), (cotan[0], F, f"Fig 6.5 after {cotan[2]['iterations']} steps"),
+              (narrow[0], narrow[1], f"Fig 7.23 after {narrow[2]['iterations']} steps"))
+    for k, (X, G, title) in enumerate(panels):
+        ax = fig.add_subplot(2, 3, k + 1, projection="3d")
+        G = np.asarray(G)
+        G = G[(G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 2] != G[:, 0])]
+        ax.plot_trisurf(X[:, 0], X[:, 1], X[:, 2], triangles=G, color="lightsteelblue", edgecolor="k", linewidth=0.2)
+        ax.set_title(title, fontsize=10)
+        ax.set_box_aspect((1, 1, 0.6))
+        ax.set_axis_off()
+    ax = fig.add_subplot(2, 1, 2)
+    for (_, _, info), label in ((cotan, "Fig 6.5 (cotan Laplacian of the surface)"),
+                                (narrow, "Fig 7.23 (flips + Laplace–Beltrami)")):
+        ax.semilogy(np.maximum(info["history"], 1e-300), "o-", ms=3, label=label)
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("max |Δf| at free vertices")
+    ax.legend(fontsize=9)
+    fig.suptitle("Fig 7.26: a start unsuited to the minimal surface")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path

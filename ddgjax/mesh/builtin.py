@@ -1,4 +1,6 @@
-"""Built-in polyhedral surfaces: each function returns `(V, F)`, V (nv, 3) float64, F int64.
+"""Built-in polyhedral surfaces: each function returns `(V, F)`, V (nv, 3) float64, F int64, and
+those made as starts of minimal-surface problems with a fixed boundary (`unit_square`,
+`tall_dome`) `(V, F, boundary)`, the boundary vertices' indices.
 
 Closed orientable ones are oriented with outward normals (faces counter-clockwise seen from
 outside).  Non-orientable ones are immersed or, for the projective plane, only combinatorially
@@ -27,6 +29,10 @@ __all__ = [
     "mobius_strip",
     "grid_quads",
     "triangulate",
+    "unit_square",
+    "cylinder",
+    "stretched_sphere",
+    "tall_dome",
 ]
 
 
@@ -220,3 +226,51 @@ def mobius_strip(m: int = 24, n: int = 4, width: float = 0.6):
     u, w = np.meshgrid(2 * np.pi * np.arange(m) / m, np.linspace(-width / 2, width / 2, n), indexing="ij")
     V = np.stack([(1 + w * np.cos(u / 2)) * np.cos(u), (1 + w * np.cos(u / 2)) * np.sin(u), w * np.sin(u / 2)], -1)
     return _mesh(V.reshape(-1, 3), triangulate(grid_quads(m, n, True, False, twist=True)))
+
+
+def unit_square(n: int):
+    """`(V, F, boundary)`: the unit square in the plane z = 0 cut into n × n squares, each split
+    into two right triangles (a Delaunay triangulation: every cotan weight is ≥ 0)."""
+    s = np.linspace(0.0, 1.0, n + 1)
+    x, y = np.repeat(s, n + 1), np.tile(s, n + 1)
+    V = np.stack([x, y, np.zeros_like(x)], 1)
+    F = triangulate(grid_quads(n + 1, n + 1, False, False))
+    return V, F, np.flatnonzero((x == 0) | (x == 1) | (y == 0) | (y == 1))
+
+
+def cylinder(n: int, R: float = 1.0, H: float = 0.5):
+    """`(V, F)`: n + 1 circles of 3n vertices on the cylinder of radius R over |z| ≤ H, the start
+    of Fig 6.5 for the catenoid spanned by its two boundary circles (edge length h ∝ 1/n)."""
+    V, F = annulus(3 * n, n + 1, 1.0, 2.0)
+    angle, s = np.arctan2(V[:, 1], V[:, 0]), np.linalg.norm(V[:, :2], axis=1) - 1.0
+    return np.stack([R * np.cos(angle), R * np.sin(angle), H * (2.0 * s - 1.0)], 1), F
+
+
+def stretched_sphere(level: int = 2, stretch=(6.0, 1.0, 0.5), bumps: float = 0.0, seed: int = 0):
+    """`(V, F)`: the icosphere stretched into a skinny ellipsoid (many non-Delaunay edges), its
+    radii scaled by 1 + `bumps` · N(0, 1) (bumps > 0 breaks the symmetries that make quadrilaterals
+    cocircular)."""
+    V, F = icosphere(level)
+    noise = 1.0 + bumps * np.random.default_rng(seed).standard_normal((len(V), 1))
+    return V * np.asarray(stretch) * noise, F
+
+
+def tall_dome(seed: int = 0, n_inner: int = 150, m: int = 32, stretch: float = 5.0, height: float = 3.0,
+              wave: float = 0.0):
+    """`(V, F, boundary)`: a start unsuited to its minimal surface (Fig 7.26).  Points in the unit
+    disk (m on the circle, `n_inner` random inside), triangulated by the planar Delaunay
+    triangulation of the points squeezed by `stretch` in y (long skinny triangles), lifted to the
+    dome z = height (1 − r²) + wave r² cos 2φ over the boundary curve z = wave cos 2φ, which
+    stays fixed (for wave = 0 the minimal surface is the flat m-gon)."""
+    from scipy.spatial import Delaunay
+
+    rng = np.random.default_rng(seed)
+    t = 2 * np.pi * np.arange(m) / m
+    r, a = np.sqrt(rng.uniform(0, 0.8, n_inner)), rng.uniform(0, 2 * np.pi, n_inner)
+    P = np.vstack([np.stack([np.cos(t), np.sin(t)], 1), np.stack([r * np.cos(a), r * np.sin(a)], 1)])
+    F = Delaunay(P * np.array([1.0, stretch])).simplices
+    u, w = P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]
+    clockwise = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0] < 0
+    F[clockwise] = F[clockwise][:, [0, 2, 1]]
+    rho2, phi = np.sum(P**2, axis=1), np.arctan2(P[:, 1], P[:, 0])
+    return np.column_stack([P, height * (1 - rho2) + wave * rho2 * np.cos(2 * phi)]), F, np.arange(m)

@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import os
-
 import importlib
+import os
 import pkgutil
 import sys
 import time
@@ -66,7 +65,13 @@ def _progress(total: int, enabled: bool):
         yield lambda description: None
         return
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+    )
 
     columns = (TextColumn("[bold]verify"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                TextColumn("{task.description}"))

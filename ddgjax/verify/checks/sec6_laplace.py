@@ -12,7 +12,7 @@ from ddgjax.errors import NonUniqueSolutionError
 from ddgjax.verify import check
 from energies import area, dirichlet
 
-from ._surfaces import catenoid_neck, cylinder, neck_radius, random_graph, unit_square
+from ._surfaces import random_graph
 
 GRAPHS = 20  # random connected graphs with positive weights per graph check
 
@@ -184,7 +184,7 @@ def area_is_dirichlet_energy(ctx, rings):
 def _catenoid(n: int):
     """Fig 6.5 from the cylinder to an area-gradient residual 0.05 h⁴-ish (0.05/n⁴): the geometry
     settles well below the O(h²) discretisation error."""
-    return area.minimal_surface(*cylinder(n), tol=0.05 / n**4, max_iter=4000)
+    return area.minimal_surface(*dg.mesh.builtin.cylinder(n), tol=0.05 / n**4, max_iter=4000)
 
 
 @check("Fig 6.5, Thm 6.7", "the Pinkall–Polthier iteration from the cylinder (stopped at max |L f| ≤ 1e-6) is critical "
@@ -192,7 +192,7 @@ def _catenoid(n: int):
        quantity="max over interior vertices of |∇A| by autodiff of the declared area", at_most=1e-6,
        quick=dict(n=16), full=dict(n=32))
 def catenoid_is_critical(ctx, n):
-    V, F, info = area.minimal_surface(*cylinder(n), tol=1e-6, max_iter=4000)
+    V, F, info = area.minimal_surface(*dg.mesh.builtin.cylinder(n), tol=1e-6, max_iter=4000)
     plot_laplace.minimal_surface(V, F, ctx.figure("catenoid.png"), history=info["history"],
                                  title=f"Fig 6.5: catenoid, n = {n}")
     if not info["area"][-1] < info["area"][0]:
@@ -206,15 +206,15 @@ def catenoid_is_critical(ctx, n):
        quantity="fitted order of |min r − c|", target=2.0, within=0.3, quick=dict(ns=(4, 6, 8, 12)),
        full=dict(ns=(8, 12, 16, 24, 32)))
 def catenoid_neck_order(ctx, ns):
-    c = catenoid_neck()
-    table = dg.limits.convergence(lambda n: abs(neck_radius(_catenoid(n)[0]) - c), ns, label="neck radius error")
+    c = area.catenoid_neck()
+    table = dg.limits.convergence(lambda n: abs(area.neck_radius(_catenoid(n)[0]) - c), ns, label="neck radius error")
     return ctx.convergence(table, "convergence_catenoid_neck", title="Fig 6.5: catenoid neck radius").fitted_order
 
 
 @check("Fig 6.5", "Newton on the area (solvers.solve) from the Pinkall–Polthier iterate converges in ≤ 5 steps",
        quantity="max_(i interior) |(L f)_i| after Newton", at_most=1e-11, quick=dict(n=4), full_only=True)
 def catenoid_newton_polish(ctx, n):
-    V1, F, _ = area.minimal_surface(*cylinder(n), tol=1e-6)
+    V1, F, _ = area.minimal_surface(*dg.mesh.builtin.cylinder(n), tol=1e-6)
     V2, _, info = area.minimal_surface(V1, F, method="newton", tol=1e-11)
     inner = _interior(len(V2), area.mesh_boundary(F, len(V2)))
     residual = float(np.max(np.abs((dg.laplace.cotan_laplacian(V2, F) @ V2)[inner])))
@@ -256,7 +256,7 @@ def negative_weights_break_convex_hull(ctx):
 
 def _laplacian_error(n: int) -> float:
     """max over interior vertices of |−(L f)_i / M_i − Δf(x_i)|, f = sin(πx) cos(2y)."""
-    V, F, b = unit_square(n)
+    V, F, b = dg.mesh.builtin.unit_square(n)
     f = np.sin(np.pi * V[:, 0]) * np.cos(2 * V[:, 1])
     approx = -(dg.laplace.cotan_laplacian(V, F) @ f) / dg.laplace.barycentric_areas(V, F)
     return float(np.max(np.abs(approx + (np.pi**2 + 4) * f)[_interior(len(V), b)]))
@@ -265,7 +265,7 @@ def _laplacian_error(n: int) -> float:
 def _harmonic_error(n: int, figure=None) -> float:
     """max |f − u| for the dDBVP solution f of the cotan Laplacian with the boundary values of the
     harmonic u = eˣ sin y."""
-    V, F, b = unit_square(n)
+    V, F, b = dg.mesh.builtin.unit_square(n)
     u = np.exp(V[:, 0]) * np.sin(V[:, 1])
     f = dirichlet.cotan_sparse(V, F, b, u[b])
     if figure is not None:

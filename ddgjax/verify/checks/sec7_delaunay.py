@@ -11,18 +11,17 @@ import scipy.sparse as sp
 
 import ddgjax as dg
 from ddgjax import intrinsic
-from ddgjax.intrinsic import rippa
+from ddgjax.intrinsic import minimal, rippa
+from ddgjax.intrinsic import plot as iplot
 from ddgjax.intrinsic import triangulation as T
 from ddgjax.intrinsic.minimal import interior_residual
 from ddgjax.verify import check
-
-from ._surfaces import draw_fig_7_26, fig_7_26, stretched_sphere, tall_dome
 
 
 def _planar_skinny(n_inner: int = 150):
     """A flat disk triangulated with long skinny (non-Delaunay) triangles: the dome of Fig 7.26
     at height 0."""
-    return tall_dome(0, n_inner=n_inner, height=0.0)
+    return dg.mesh.builtin.tall_dome(0, n_inner=n_inner, height=0.0)
 
 
 @check("Lemma 5.8", "flipping an edge of a flat surface gives the other diagonal of the unfolded quadrilateral",
@@ -52,7 +51,7 @@ def _opposite_angle_sums(tri) -> np.ndarray:
 @functools.cache
 def _flipped(level: int, bumps: float = 0.0):
     """The stretched icosphere, its triangulation and the result of the flip algorithm."""
-    V, F = stretched_sphere(level, bumps=bumps)
+    V, F = dg.mesh.builtin.stretched_sphere(level, bumps=bumps)
     tri = T.from_mesh(V, F)
     return tri, intrinsic.flip_to_delaunay(tri)
 
@@ -280,7 +279,7 @@ def laplace_beltrami_isometry_invariant(ctx):
     return float(abs(L - L_pushed).max() / abs(L).max()) if np.linalg.norm(pushed[0] - V[0]) > 0.1 else float("inf")
 
 
-_fig_7_26 = functools.cache(fig_7_26)
+_fig_7_26 = functools.cache(minimal.fig_7_26)
 FIG_7_26 = dict(quick=dict(seed=0, budget=30), full=dict(seed=1, budget=200))  # the sizes of the Fig 7.26 checks
 
 
@@ -300,7 +299,7 @@ def narrow_minimal_surface_converges(ctx, seed, budget):
     fixed = np.zeros(len(W), dtype=bool)
     fixed[boundary] = True
     residual = interior_residual(intrinsic.cotan_laplacian(tri), W, fixed)
-    draw_fig_7_26(ctx.figure("fig_7_26.png"), V, F, cotan, (W, F1, info))
+    iplot.draw_fig_7_26(ctx.figure("fig_7_26.png"), V, F, cotan, (W, F1, info))
     polygon = 0.5 * 32 * np.sin(2 * np.pi / 32)
     ok = info["converged"] and intrinsic.is_delaunay(tri) and info["flips"].sum() > 0
     return residual + abs(info["area"][-1] - polygon) / polygon if ok else float("inf")

@@ -6,6 +6,7 @@ import jax
 import numpy as np
 
 from ddgjax.verify import check
+from energies import elastica
 from solvers import solve
 from solvers.problems import random_symmetric, rayleigh
 
@@ -29,3 +30,17 @@ def rayleigh_eigenvalue_derivative(ctx, n):
     x = np.asarray(sol.x)
     # A is used symmetrically (xᵀAx), so the derivative with respect to the entries is x xᵀ
     return float(np.max(np.abs(np.asarray(gradient) - np.outer(x, x))))
+
+
+@check("linear algebra paths", "dense LU, sparse KLU and matrix-free Krylov (MINRES on the constraints' tangent space) "
+       "reach the same clamped elastica and multipliers",
+       quantity="max |x − x_dense| + |λ − λ_dense| over sparse, Krylov", at_most=1e-10, quick=dict(n=12), full=dict(n=40))
+def linear_algebra_paths_agree(ctx, n):
+    problem = elastica.clamped(n, chord=(0.5, 0.3, 0.1), t_start=(1, 0, 0), t_end=(0, 1, 0), clamp="vertex")
+    dense = solve(problem, method="dense", tol=1e-11)
+    gaps = []
+    for method in ("sparse", "krylov"):
+        other = solve(problem, method=method, tol=1e-11)
+        gaps.append(float(np.max(np.abs(np.asarray(other.x) - np.asarray(dense.x))))
+                    + float(np.max(np.abs(np.asarray(other.multipliers) - np.asarray(dense.multipliers)))))
+    return max(gaps)
