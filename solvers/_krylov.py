@@ -1,10 +1,10 @@
-"""Matrix-free Newton–Krylov: the KKT system solved on the tangent space of the constraint set.
+"""Newton–Krylov: the KKT system solved by preconditioned Krylov methods, inside `jit`.
 
 `method="krylov"`.  Nothing is factorised, so the whole solver stays inside `jit` on any backend
 (GPUs and TPUs have no sparse LU that `jit`, `vmap` and `grad` go through); the linear algebra
 is matrix–vector products and a few vector reductions per iteration.
 
-**The tangent-space solve.**  For `K d = b` with `K = [[H, −Jᵀ], [−J, 0]]` (`_kkt.py`), i.e.
+**The tangent-space solve** (every problem that is not a chain, below).  For `K d = b` with `K = [[H, −Jᵀ], [−J, 0]]` (`_kkt.py`), i.e.
 
     H d₁ − Jᵀ d₂ = b₁,     −J d₁ = b₂,
 
@@ -26,6 +26,15 @@ chord) `S` is diagonal plus a low-rank border and CG converges in a few iteratio
 constraints the method is MINRES preconditioned by `M⁻¹`.  Unpreconditioned Krylov methods on
 the full, indefinite KKT matrix do not converge at these sizes (`SOLVER-NOTES.md`).
 
+**Chains.**  For a problem on a curve (every stencil on a few consecutive rows of x: elastica,
+rods, the pendulum's action) the KKT matrix is block tridiagonal apart from the rows of global
+sums (a chord), and `_banded` solves the block-tridiagonal part exactly by block elimination
+(two `lax.scan`s).  The solve is then GMRES on the whole KKT matrix preconditioned by it: the
+preconditioned matrix is the identity plus a perturbation of rank at most twice the number of
+global constraints, so GMRES needs a handful of iterations at every n (10⁵ elastica edges:
+2 s per Newton step on the CPU, where the Jacobi-preconditioned MINRES needs about n
+iterations).
+
 **Operators.**  For a problem declared local (`dg.local_sum`) the products use the assembled
 sparse blocks of `K` (the same values as `method="sparse"`) and `M = |diag H|` (Jacobi);
 otherwise `K v` is a forward-over-reverse product of the Lagrangian (`jax.linearize`) and
@@ -43,13 +52,16 @@ from typing import Callable
 
 import jax
 import jax.numpy as jnp
-from jax.scipy.sparse.linalg import cg
+from jax.scipy.sparse.linalg import cg, gmres
 
+from . import _banded as banded
+from ._banded import Chain, chain_arrays, chain_structure
 from ._kkt import KKT
 from ._linear import _Algebra
 from ._sparse import PatternKey, SparsePattern, index_arrays, kkt_values
 
 RTOL = 1e-12
+CHAIN_RESTART, CHAIN_CYCLES = 10, 2  # GMRES with the block-tridiagonal preconditioner (border rank ≤ 2·3 for a chord)
 JACOBI_FLOOR = 1e-12  # |diag H| below this (relative to its largest entry) is raised to it
 
 
@@ -125,6 +137,7 @@ class Linearisation:
     diag_h: object
     jacobi_s: Callable | None
     scale: object
+    values: object = None  # the coalesced sparse values of K (local problems)
 
 
 @dataclass(frozen=True)
@@ -135,6 +148,7 @@ class Factored:
     mu: object
     minv: object
     sinv: object  # the Jacobi preconditioner of S, or None
+    chain: object = None  # the block-tridiagonal factors (`_banded.factor`), or None
 
 
 def _sparse_linearisation(pattern: SparsePattern, index: dict, kkt: KKT, w, identity_hessian: bool) -> Linearisation:
@@ -161,7 +175,7 @@ def _sparse_linearisation(pattern: SparsePattern, index: dict, kkt: KKT, w, iden
     def jacobi_s(minv):
         return jax.ops.segment_sum(j_vals**2 * minv[j_cols], j_rows, num_segments=m)
 
-    return Linearisation(n, m, hvp, jvp, vjp, kvp, values[diag_at], jacobi_s, jnp.max(jnp.abs(values)))
+    return Linearisation(n, m, hvp, jvp, vjp, kvp, values[diag_at], jacobi_s, jnp.max(jnp.abs(values)), values)
 
 
 def _autodiff_linearisation(kkt: KKT, w, identity_hessian: bool) -> Linearisation:
@@ -195,22 +209,35 @@ class KrylovAlgebra(_Algebra):
     problem is local) are its leaves."""
 
     def __init__(self, pattern: SparsePattern | None = None, rtol: float = RTOL, maxiter: int | None = None,
-                 index: dict | None = None):
+                 index: dict | None = None, chain: Chain | None = None):
         self.pattern = pattern
         self.rtol = float(rtol)
         self.maxiter = maxiter
-        self.index = index if index is not None or pattern is None else index_arrays(pattern)
+        self.chain = chain
+        if index is None and pattern is not None:
+            index = dict(index_arrays(pattern), **({} if chain is None else chain_arrays(chain)))
+        self.index = index
+
+    @classmethod
+    def of(cls, pattern: SparsePattern | None, spec) -> KrylovAlgebra:
+        """The back end for a problem: with the block-tridiagonal preconditioner if it is a chain."""
+        if pattern is None:
+            return cls()
+        if "_chain" not in pattern.__dict__:  # made once per pattern: jit's cache compares it by identity
+            shape = spec.layout.shapes[0]
+            pattern.__dict__["_chain"] = chain_structure(pattern, spec.layout.free, shape[1] if len(shape) == 2 else 1)
+        return cls(pattern, chain=pattern.__dict__["_chain"])
 
     def tree_flatten(self):
         names = () if self.index is None else tuple(sorted(self.index))
         key = None if self.pattern is None else PatternKey(self.pattern)
-        return tuple(self.index[k] for k in names), (key, self.rtol, self.maxiter, names)
+        return tuple(self.index[k] for k in names), (key, self.rtol, self.maxiter, names, self.chain)
 
     @classmethod
     def tree_unflatten(cls, aux, children):
-        key, rtol, maxiter, names = aux
+        key, rtol, maxiter, names, chain = aux
         index = dict(zip(names, children)) if key is not None else None
-        return cls(None if key is None else key.pattern, rtol, maxiter, index)
+        return cls(None if key is None else key.pattern, rtol, maxiter, index, chain)
 
     def matrix(self, kkt: KKT, w, identity_hessian=False) -> Linearisation:
         if self.pattern is not None:
@@ -228,7 +255,8 @@ class KrylovAlgebra(_Algebra):
         if K.m and K.jacobi_s is not None:
             s = K.jacobi_s(minv)
             sinv = 1.0 / jnp.where(s > 0, s, 1.0)
-        return Factored(K, mu, minv, sinv)
+        chain = None if self.chain is None else banded.factor(self.chain, self.index, K.values, mu)
+        return Factored(K, mu, minv, sinv, chain)
 
     def _schur_solve(self, fac: Factored, r):
         """`S⁻¹ r`, `S = J M⁻¹ Jᵀ`, by Jacobi-preconditioned CG."""
@@ -249,6 +277,8 @@ class KrylovAlgebra(_Algebra):
         return minv * (r - K.vjp(self._schur_solve(fac, K.jvp(minv * r))))
 
     def apply(self, fac: Factored, b):
+        if fac.chain is not None:
+            return self._apply_chain(fac, b)
         K, minv = fac.K, fac.minv
         n, m = K.n, K.m
         b1, b2 = b[:n], b[n:]
@@ -273,6 +303,21 @@ class KrylovAlgebra(_Algebra):
             return d1
         d2 = self._schur_solve(fac, K.jvp(minv * (H(d1) - b1)))
         return jnp.concatenate([d1, d2])
+
+    def _apply_chain(self, fac: Factored, b):
+        """GMRES on `(K + μS) d = b` preconditioned by the block-tridiagonal solve (`_banded`)."""
+        K = fac.K
+        sign = jnp.concatenate([jnp.ones((K.n,)), -jnp.ones((K.m,))])
+
+        def A(v):
+            return K.kvp(v) + fac.mu * sign * v
+
+        def precondition(r):
+            return banded.solve(self.chain, self.index, fac.chain, r)
+
+        restart = min(CHAIN_RESTART, b.shape[0])
+        d, _ = gmres(A, b, M=precondition, tol=self.rtol, atol=0.0, restart=restart, maxiter=CHAIN_CYCLES)
+        return d
 
     def matvec(self, K: Linearisation, v):
         return K.kvp(v)

@@ -77,7 +77,7 @@ def _choose_algebra(problem: Problem, spec: Spec, method: str):
     if method == "sparse":
         return SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
     if method == "krylov":
-        return KrylovAlgebra(cached_pattern(spec, problem.x0, problem.params) if spec.is_local else None)
+        return KrylovAlgebra.of(cached_pattern(spec, problem.x0, problem.params) if spec.is_local else None, spec)
     return DenseAlgebra()
 
 
@@ -135,8 +135,9 @@ def solve(
     - `tol`: stop when the scaled max-norm KKT residual is `<= tol` (see `Problem.residual_scale`).
     - `max_steps`: Newton steps (outer augmented-Lagrangian steps for `method="lbfgs"`).
     - `method`: `"dense"` (LU, n ≲ 2,000), `"sparse"` (KLU on the KKT matrix assembled from a
-      locality declaration, `dg.local_sum`; CPU), `"krylov"` (matrix-free Newton–MINRES on the
-      constraints' tangent space, inside `jit` on any backend: `solvers/_krylov.py`),
+      locality declaration, `dg.local_sum`; CPU), `"krylov"` (inside `jit` on any backend,
+      `solvers/_krylov.py`: GMRES preconditioned by a block-tridiagonal solve for problems on
+      curves, MINRES on the constraints' tangent space with a Jacobi metric otherwise),
       `"lbfgs"` (augmented Lagrangian with jaxopt L-BFGS inner solves: minimisation only,
       first-order), or `"auto"` (`choose_method`: sparse for a problem declared local on the
       CPU, else dense up to N = n + m = 2,000 unknowns and multipliers, else Krylov).
