@@ -112,9 +112,9 @@ def chain_structure(pattern: SparsePattern, free_flat: np.ndarray, width: int) -
 
 def chain_arrays(chain: Chain) -> dict:
     """The chain's index arrays (arguments of the compiled solver, like `_sparse.index_arrays`)."""
-    return {"chain_slot": jnp.asarray(chain.slot, jnp.int32), "chain_d_at": jnp.asarray(chain.d_at),
-            "chain_d_pos": jnp.asarray(chain.d_pos), "chain_u_at": jnp.asarray(chain.u_at),
-            "chain_u_pos": jnp.asarray(chain.u_pos)}
+    names = ("slot", "d_at", "d_pos", "u_at", "u_pos")
+    with jax.ensure_compile_time_eval():  # concrete even when made under a trace
+        return {f"chain_{k}": jnp.asarray(np.asarray(getattr(chain, k), dtype=np.int32)) for k in names}
 
 
 def factor(chain: Chain, index: dict, values, mu):

@@ -298,7 +298,8 @@ def index_arrays(pattern: SparsePattern) -> dict:
         split = pattern.split()
         if split is not None:
             arrays.update({f"split_{name}": getattr(split, name) for name in SPLIT_ARRAYS})
-        pattern.__dict__["_index"] = {k: jnp.asarray(np.asarray(v, dtype=np.int32)) for k, v in arrays.items()}
+        with jax.ensure_compile_time_eval():  # concrete arrays even when first made under a trace (shard_map)
+            pattern.__dict__["_index"] = {k: jnp.asarray(np.asarray(v, dtype=np.int32)) for k, v in arrays.items()}
     return pattern.__dict__["_index"]
 
 

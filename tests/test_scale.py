@@ -68,7 +68,7 @@ SHARDED = textwrap.dedent(
     from solvers import solve_batch
     assert len(jax.devices()) == 2, jax.devices()
     problem = elastica.clamped(10, chord=(0.6, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
-    for method, size in (("sparse", 5), ("dense", 4)):
+    for method, size in (("sparse", 5), ("dense", 4), ("krylov", 4)):
         chords = jnp.stack([jnp.array([0.5 + 0.04 * k, 0.2, 0.0]) for k in range(size)])
         plain = solve_batch(problem, {"chord": chords}, method=method)
         shared = solve_batch(problem, {"chord": chords}, method=method, devices="all")
@@ -85,7 +85,7 @@ def test_batch_sharded_over_two_cpu_devices_equals_unsharded():
     out = subprocess.run([sys.executable, "-c", SHARDED], cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-3000:]
     lines = dict(line.split(" ", 1) for line in out.stdout.strip().splitlines())
-    for method in ("sparse", "dense"):
+    for method in ("sparse", "dense", "krylov"):
         diff, converged = lines[method].split()
         assert float(diff) <= 1e-12 and converged == "True"
 
