@@ -231,13 +231,16 @@ class KrylovAlgebra(_Algebra):
     def tree_flatten(self):
         names = () if self.index is None else tuple(sorted(self.index))
         key = None if self.pattern is None else PatternKey(self.pattern)
-        return tuple(self.index[k] for k in names), (key, self.rtol, self.maxiter, names, self.chain)
+        # the chain is found on the pattern (`of`), so that the static part compares by the
+        # pattern's structure only and problems declared alike share one compiled solver
+        return tuple(self.index[k] for k in names), (key, self.rtol, self.maxiter, names, self.chain is not None)
 
     @classmethod
     def tree_unflatten(cls, aux, children):
-        key, rtol, maxiter, names, chain = aux
-        index = dict(zip(names, children)) if key is not None else None
-        return cls(None if key is None else key.pattern, rtol, maxiter, index, chain)
+        key, rtol, maxiter, names, has_chain = aux
+        if key is None:
+            return cls(None, rtol, maxiter)
+        return cls(key.pattern, rtol, maxiter, dict(zip(names, children)), key.pattern.__dict__["_chain"] if has_chain else None)
 
     def matrix(self, kkt: KKT, w, identity_hessian=False) -> Linearisation:
         if self.pattern is not None:

@@ -57,7 +57,7 @@ def choose_method(spec: Spec, backend: str) -> str:
       size we measured (N = 10²: 1.0 vs 2.6 ms, `benchmarks/solver.py`);
     - `"dense"` when N = n + m ≤ `DENSE_MAX` otherwise (one LU on an accelerator is fast);
     - `"krylov"` for larger problems that are not local-on-CPU (KLU runs on the CPU only, and
-      dense LU does not fit): matrix-free, inside `jit` on any backend.
+      dense LU does not fit): no factorisation, inside `jit` on any backend.
     """
     if spec.is_local and backend == "cpu":
         return "sparse"
