@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import ddgjax as dg
-from energies import area, dirichlet, elastica, pendulum, rod
 from ddgjax import quaternion as qt
+from energies import area, dirichlet, elastica, pendulum, rod
 from solvers import solve, solve_batch
 from solvers._kkt import KKT, spec_of
 from solvers._linear import DenseAlgebra, SparseAlgebra
