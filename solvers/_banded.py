@@ -82,12 +82,14 @@ def chain_structure(pattern: SparsePattern, free_flat: np.ndarray, width: int) -
     n_blocks = int(block.max()) + 1 if (~border).any() else 0
     within = np.where(np.arange(n + m) < n, (np.concatenate([free_flat, np.zeros(m, np.int64)]) % (group * width)), 0)
     # multipliers take the slots after the g·d unknown slots of their block, in index order
-    counter = np.zeros(n_blocks, dtype=np.int64)
     cons = np.flatnonzero((np.arange(n + m) >= n) & ~border)
-    for c in cons:  # m local constraints: a short NumPy loop, once per pattern
-        within[c] = group * width + counter[block[c]]
-        counter[block[c]] += 1
-    size = group * width + (int(counter.max()) if n_blocks else 0)
+    order = np.argsort(block[cons], kind="stable")
+    in_order = block[cons][order]
+    rank = np.empty(cons.size, dtype=np.int64)
+    rank[order] = np.arange(cons.size) - np.searchsorted(in_order, in_order, side="left")
+    within[cons] = group * width + rank
+    counts = np.bincount(block[cons], minlength=n_blocks) if cons.size else np.zeros(1, np.int64)
+    size = group * width + (int(counts.max()) if n_blocks else 0)
     if n_blocks == 0 or size > MAX_BLOCK:
         return None
     rows, cols = pattern.rows.astype(np.int64), pattern.cols.astype(np.int64)

@@ -249,6 +249,8 @@ class KrylovAlgebra(_Algebra):
 
     def factor_matrix(self, kkt: KKT, K: Linearisation, mu_rel) -> Factored:
         mu = mu_rel * jnp.maximum(K.scale, 1.0)
+        if self.chain is not None:  # the block-tridiagonal preconditioner replaces the Jacobi one
+            return Factored(K, mu, None, None, banded.factor(self.chain, self.index, K.values, mu))
         if K.diag_h is None:
             minv = jnp.ones((K.n,), dtype=K.scale.dtype)
         else:
@@ -258,8 +260,7 @@ class KrylovAlgebra(_Algebra):
         if K.m and K.jacobi_s is not None:
             s = K.jacobi_s(minv)
             sinv = 1.0 / jnp.where(s > 0, s, 1.0)
-        chain = None if self.chain is None else banded.factor(self.chain, self.index, K.values, mu)
-        return Factored(K, mu, minv, sinv, chain)
+        return Factored(K, mu, minv, sinv)
 
     def _schur_solve(self, fac: Factored, r):
         """`S⁻¹ r`, `S = J M⁻¹ Jᵀ`, by Jacobi-preconditioned CG."""
