@@ -57,7 +57,7 @@ from jax.scipy.sparse.linalg import cg, gmres
 from . import _banded as banded
 from ._banded import Chain, chain_arrays, chain_structure
 from ._kkt import KKT
-from ._linear import _Algebra
+from ._linear import _Algebra, _regularisation
 from ._sparse import PatternKey, SparsePattern, index_arrays, kkt_values
 
 RTOL = 1e-12
@@ -311,10 +311,10 @@ class KrylovAlgebra(_Algebra):
     def _apply_chain(self, fac: Factored, b):
         """GMRES on `(K + μS) d = b` preconditioned by the block-tridiagonal solve (`_banded`)."""
         K = fac.K
-        sign = jnp.concatenate([jnp.ones((K.n,)), -jnp.ones((K.m,))])
+        shift = _regularisation(K.n, K.m, fac.mu)  # μS, as the direct back ends add it
 
         def A(v):
-            return K.kvp(v) + fac.mu * sign * v
+            return K.kvp(v) + shift * v
 
         def precondition(r):
             return banded.solve(self.chain, self.index, fac.chain, r)
