@@ -63,6 +63,7 @@ import numpy as np  # noqa: E402
 import scipy.optimize  # noqa: E402
 
 import ddgjax as dg  # noqa: E402  (float64)
+from ddgjax.problem import constraint_values  # noqa: E402
 from energies import elastica  # noqa: E402
 from solvers import solve  # noqa: E402
 
@@ -94,7 +95,7 @@ class FlatProblem:
             return problem.energy(x_of(u), params)
 
         def constraints(u):
-            return jnp.ravel(problem.constraints(x_of(u), params))
+            return constraint_values(problem, x_of(u), params)
 
         self.free = free
         self.f = jax.jit(energy)

@@ -5,8 +5,9 @@ side by side with libigl's `intrinsic_delaunay_cotmatrix` and robust-laplacian's
 
 Meshes of about 10⁴, 10⁵, 10⁶ faces: a round icosphere (Delaunay already, no flips), a strongly
 stretched ellipsoid (the icosphere scaled 20 : 1 : 1) and a sheared, squashed torus of thin
-triangles; the last two need about 1.5 flips per face.  ddgjax is numpy (no JIT, so no compile
-time; the first call is a warm-up and not counted).  Calls are interleaved and both wall and CPU
+triangles; the last two need about 1.5 flips per face.  ddgjax's flips are numpy (no JIT); its
+cotan weights are one jit-compiled autodiff kernel, compiled for a few shape buckets (the first
+call is a warm-up and not counted).  Calls are interleaved and both wall and CPU
 time (`time.process_time`, all three run on one core) are reported: on a shared machine the CPU
 time is the fairer measure.  The flip phase is also timed alone (`flip_to_delaunay` on a prebuilt
 triangulation, no history) and divided by the flip count.

@@ -5,7 +5,7 @@ Pinkall–Polthier step (Fig 6.5), side by side with libigl + scipy.
    `bincount` into the csr structure of F, cached)
    against `igl.cotmatrix(V, F)` (which is −L) on tori of 10⁴, 10⁵, 10⁶ faces.
 2. Dirichlet problem on a jittered square grid of ~10⁵ vertices, the boundary values of eˣ sin y:
-   `dg.laplace.dirichlet_solve(cotan_laplacian(V, F), ...)` (splu of the interior block) and
+   `dirichlet.dirichlet_solve(cotan_laplacian(V, F), ...)` (splu of the interior block) and
    `dirichlet.cotan_sparse` (the same plus the manifold check of `mesh.from_faces`) against
    `−igl.cotmatrix` + `scipy.sparse.linalg.spsolve` on the interior block.
 3. One Pinkall–Polthier step on a cylinder of ~10⁵ vertices: `area.pinkall_polthier_step` (cotan
@@ -26,7 +26,7 @@ libigl 2.x from pip, scipy SuperLU; one full run takes about a minute:
 | 10000 faces | cotan Laplacian assembly | 0.53 | 1.5 | 2.6 | 1.78 | 2.7e-15 |
 | 99856 faces | cotan Laplacian assembly | 0.51 | 15.6 | 46.7 | 2.99 | 3.6e-15 |
 | 1000000 faces | cotan Laplacian assembly | 1.99 | 220.0 | 495.3 | 2.25 | 3.6e-15 |
-| 99856 vertices | Dirichlet problem: laplace.dirichlet_solve | 0.58 | 836.3 | 1290.5 | 1.54 | 5.8e-14 |
+| 99856 vertices | Dirichlet problem: dirichlet.dirichlet_solve | 0.58 | 836.3 | 1290.5 | 1.54 | 5.8e-14 |
 | 99856 vertices | Dirichlet problem: dirichlet.cotan_sparse (validated) | 0.01 | 1989.0 | 1160.1 | 0.58 | 5.8e-14 |
 | 100467 vertices | one Pinkall–Polthier step | 0.46 | 700.1 | 1212.4 | 1.73 | 6.2e-14 |
 
@@ -135,7 +135,7 @@ def main():
     c = np.exp(V[b, 0]) * np.sin(V[b, 1])
     theirs = (lambda: igl_dirichlet(igl, V, F, b, c)) if igl else None
     size = f"{len(V)} vertices"
-    print(_row(size, "Dirichlet problem: laplace.dirichlet_solve", lambda: dg.laplace.dirichlet_solve(
+    print(_row(size, "Dirichlet problem: dirichlet.dirichlet_solve", lambda: dirichlet.dirichlet_solve(
         dg.laplace.cotan_laplacian(V, F), b, c), theirs, args.repeats), flush=True)
     print(_row(size, "Dirichlet problem: dirichlet.cotan_sparse (validated)",
                lambda: dirichlet.cotan_sparse(V, F, b, c), theirs, args.repeats), flush=True)

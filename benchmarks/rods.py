@@ -43,7 +43,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import ddgjax as dg  # noqa: F401  (float64)
-from ddgjax import kirchhoff
+from ddgjax.smooth import kirchhoff
 from ddgjax import quaternion as qt
 from energies import rod
 from solvers import solve

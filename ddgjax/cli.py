@@ -178,7 +178,7 @@ def _solve_minimal_surface(args) -> int:
     residual, iterations = info.get("residual", float("nan")), info.get("iterations", "?")
     print(f"residual      {residual:.2e} after {iterations} iterations ({args.method})")
     if args.plot:
-        from . import plot_surface
+        from .plot import surface as plot_surface
 
         print("figure       ", plot_surface.surface(V, F, path=args.plot, color_by="mean_curvature"))
     return 0

@@ -22,6 +22,10 @@ __all__ = [
     "NonManifoldError",
     "OrientationError",
     "TriangleInequalityError",
+    "GluingError",
+    "FlipBudgetError",
+    "DegenerateFaceError",
+    "NonUniqueSolutionError",
 ]
 
 
@@ -119,8 +123,6 @@ class FlipBudgetError(DDGError, RuntimeError):
     """
 
 
-__all__ += ["GluingError", "FlipBudgetError"]
-
 
 class DegenerateFaceError(MeshError):
     """A triangle has zero area (up to round-off): its cotangents and the gradient of an affine
@@ -134,5 +136,3 @@ class NonUniqueSolutionError(InvalidInputError):
     The message names a vertex of that component.
     """
 
-
-__all__ += ["DegenerateFaceError", "NonUniqueSolutionError"]

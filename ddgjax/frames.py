@@ -118,7 +118,7 @@ def frame_from_curvatures(Phi0, curvatures_of_s: Callable, length: float, *, ste
     **Returns:** `(s, Phi)`: the steps + 1 parameters and frames (steps + 1, 4).
     **Raises:** `InvalidInputError` (Φ0 not unit), `ShapeError`, `NonFiniteError`.
     """
-    Phi0 = qt._as_quaternion(Phi0, "Phi0")
+    Phi0 = qt.as_quaternion(Phi0, "Phi0")
     qt.check_unit(Phi0, "Phi0")
 
     def f(state):
@@ -138,7 +138,7 @@ def _as_edge_frames(Phi) -> Array:
     shape = np.shape(Phi)
     if len(shape) != 2 or shape[1] != 4 or shape[0] < 2:
         raise ShapeError(f"Phi must be an (n, 4) array of unit quaternions, one frame per edge, n >= 2; got shape {shape}")
-    Phi = qt._as_quaternion(Phi, "Phi")
+    Phi = qt.as_quaternion(Phi, "Phi")
     qt.check_unit(Phi, "Phi")
     return Phi
 
@@ -154,11 +154,12 @@ def _check_not_antiparallel(T: Array) -> None:
 
 
 def _split(Phi: Array) -> tuple[Array, Array, Array]:
-    T = qt._rotate(Phi, jnp.asarray(E[0]))
+    T = qt.rotate(Phi, jnp.asarray(E[0]))
+    _check_not_antiparallel(T)
     T_prev, T_next = T[:-1], T[1:]
     b = jnp.concatenate([1 + jnp.sum(T_prev * T_next, -1, keepdims=True), jnp.cross(T_prev, T_next)], -1)
     b = b / jnp.linalg.norm(b, axis=-1, keepdims=True)
-    t = qt._mul(qt._mul(Phi[1:], qt._conj(Phi[:-1])), qt._conj(b))
+    t = qt.mul(qt.mul(Phi[1:], qt.conj(Phi[:-1])), qt.conj(b))
     # t = ±(cos θ/2 + sin θ/2 T_k): pick the sign with cos θ/2 ≥ 0 so θ ∈ (−π, π]
     sign = jnp.where(t[..., 0] < 0, -1.0, 1.0)
     theta = 2 * jnp.arctan2(sign * jnp.sum(t[..., 1:] * T_next, -1), sign * t[..., 0])
@@ -174,8 +175,7 @@ def edge_frame_split(Phi: Float[Array, "n 4"]) -> tuple[Float[Array, "m 4"], Flo
     `SingularVertexError` (T_k = −T_{k−1}, naming the vertex), `NonFiniteError`.
     """
     Phi = _as_edge_frames(Phi)
-    T, b, theta = _split(Phi)
-    _check_not_antiparallel(T)
+    _, b, theta = _split(Phi)
     return b, theta
 
 
@@ -190,11 +190,10 @@ def discrete_curvatures(Phi: Float[Array, "n 4"], h: float = 1.0) -> tuple[Array
     if not h > 0:
         raise InvalidInputError(f"edge length h must be positive, got {h}")
     Phi = _as_edge_frames(Phi)
-    T, b, theta = _split(Phi)
-    _check_not_antiparallel(T)
+    _, b, theta = _split(Phi)
     half_twist = qt.from_axis_angle(jnp.asarray(E[0]), 0.5 * theta)
-    Psi = qt._mul(Phi[:-1], half_twist)
-    beta = qt._mul(qt._mul(qt._conj(Psi), b), Psi)
+    Psi = qt.mul(Phi[:-1], half_twist)
+    beta = qt.mul(qt.mul(qt.conj(Psi), b), Psi)
     K = 2 * beta[..., 1:] / (h * beta[..., :1])
     return K[..., 2], -K[..., 1], theta / h
 

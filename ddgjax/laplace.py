@@ -8,17 +8,20 @@ so `L = ∇²E` and `L·1 = 0`.  libigl's `cotmatrix` is the negative semidefini
 Laplacian is `Δf(x_i) ≈ −(L f)_i / M_i` with `M_i` the vertex area (`barycentric_areas`).
 
 **Where the cotan weights come from.**  The Dirichlet energy of the affine interpolant on one
-triangle (Sec 6.3) is declared from the triangle's positions alone (`triangle_dirichlet_energy`:
-`½ A |∇f|²`, written with the Gram matrix of two edges, no angles).  Its 3×3 Hessian in the vertex
-values, taken by autodiff (`triangle_stiffness`), is the local stiffness matrix whose off-diagonal
-entry at the edge opposite corner k is `−½ cot α_k` (Thm 6.6); the sparse Laplacian is the sum of
-these blocks (finite-element assembly: a `bincount` into the csr structure of F, which is built
-once per connectivity and cached), i.e. the cotan weights (6.2)
+triangle (Sec 6.3) is declared from the triangle's squared side lengths alone
+(`ddgjax.mesh.lengths.dirichlet_energy`: `½ A |∇f|²`, the Gram matrix of two edges written in
+squared lengths, no angles).  Its 3×3 Hessian in the vertex values, taken by autodiff
+(`ddgjax.mesh.lengths.stiffness`), is the local stiffness matrix whose off-diagonal entry at the
+edge opposite corner k is `−½ cot α_k` (Thm 6.6); the sparse Laplacian is the sum of these blocks
+(finite-element assembly, `laplacian_of_corner_weights`: a `bincount` into the csr structure of F,
+which is built once per connectivity and cached), i.e. the cotan weights (6.2)
 
     ν(ij) = ½ (cot α_ij + cot α_ji) on interior edges,   ν(ij) = ½ cot α_ij on boundary edges.
 
-The autodiff Hessian is jit-compiled (XLA fuses it into one pass over the faces); it is faster
-than the closed-form cotangent formula in numpy.
+The same derivation serves every Laplacian of ddgjax: here composed with the squared side lengths
+of a mesh (V, F); in `ddgjax.intrinsic` with the lengths of an intrinsic triangulation (after
+edge flips: the Laplace–Beltrami operator).  The autodiff Hessian is jit-compiled (XLA fuses it
+into one pass over the faces).
 """
 
 from __future__ import annotations
@@ -26,35 +29,38 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
 from jaxtyping import Array, Float, Int
-from scipy.sparse.csgraph import connected_components
-from scipy.sparse.linalg import splu
 
-from ._checks import check_finite
 from .errors import (
     DegenerateFaceError,
     InvalidInputError,
     MeshError,
     NonFiniteError,
-    NonUniqueSolutionError,
     ShapeError,
+)
+from .mesh.connectivity import boundary_indices, from_faces
+from .mesh.lengths import (
+    corner_weights,
+    dirichlet_energy,
+    squared_side_lengths,
+    stiffness,
+    triangle_area,
 )
 
 __all__ = [
     "barycentric_areas",
     "boundary_indices",
     "check_nondegenerate",
-    "check_unique",
     "checked_triangle_mesh",
     "cotan_laplacian",
     "cotan_weights",
-    "dirichlet_solve",
     "edge_cotan_weights",
+    "face_areas",
     "graph_laplacian",
-    "triangle_area",
+    "laplacian_of_corner_weights",
+    "laplacian_of_edge_weights",
     "triangle_dirichlet_energy",
     "triangle_stiffness",
 ]
@@ -64,58 +70,23 @@ __all__ = [
 DEGENERATE = 1e-14
 
 
-def _twice_area_squared(e1, e2):
-    n = jnp.cross(e1, e2)
-    return jnp.dot(n, n)
-
-
-def triangle_dirichlet_energy(f: Float[Array, "3"], P: Float[Array, "3 3"]) -> Float[Array, ""]:
-    """Dirichlet energy of the affine interpolant of the values f on the triangle P (Sec 6.3):
-
-        E_F(f) = ½ ∫_F |∇f|² dA = ½ A |∇f|²,    |∇f|² = dᵀ G⁻¹ d,   A = ½ √det G,
-
-    with the edges e1 = P1 − P0, e2 = P2 − P0, their Gram matrix G and d = (f1 − f0, f2 − f0).
-    It equals ¼ Σ_i cot α_i (f_{i+1} − f_{i−1})² (Sec 6.3), but is written without angles, so
-    its Hessian in f (by autodiff) *derives* the cotan weights (Thm 6.6).
-    """
-    e1, e2 = P[1] - P[0], P[2] - P[0]
-    g11, g12, g22 = jnp.dot(e1, e1), jnp.dot(e1, e2), jnp.dot(e2, e2)
-    d1, d2 = f[1] - f[0], f[2] - f[0]
-    return (g22 * d1 * d1 - 2.0 * g12 * d1 * d2 + g11 * d2 * d2) / (4.0 * jnp.sqrt(_twice_area_squared(e1, e2)))
-
-
-def triangle_area(P: Float[Array, "3 3"]) -> Float[Array, ""]:
-    """A(F) = ½ |(P1 − P0) × (P2 − P0)| (Sec 6.4)."""
-    return 0.5 * jnp.sqrt(_twice_area_squared(P[1] - P[0], P[2] - P[0]))
-
-
-def _stiffness(P):
-    return jax.vmap(jax.hessian(triangle_dirichlet_energy), in_axes=(None, 0))(jnp.zeros(3, P.dtype), P)
-
-
-def _sin2(P):
-    """sin² of each face's angle at corner 0 (0 for a zero-area face, NaN for a zero edge)."""
-    e1, e2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
-    return jax.vmap(_twice_area_squared)(e1, e2) / (jnp.sum(e1 * e1, 1) * jnp.sum(e2 * e2, 1))
+def triangle_dirichlet_energy(f: Float[Array, "3"], P: Float[Array, "3 n"]) -> Float[Array, ""]:
+    """Dirichlet energy ½ ∫ |∇f|² dA of the affine interpolant of the values f on the triangle P
+    (Sec 6.3): `ddgjax.mesh.lengths.dirichlet_energy` of its squared side lengths."""
+    return dirichlet_energy(f, squared_side_lengths(P))
 
 
 @jax.jit
-def _shape(V, F):
-    return _sin2(V[F])
+def _corner_weights_of_positions(V, F):
+    """(nf, 3) ½ cot α_k derived by autodiff (`mesh.lengths.corner_weights`) and sin² of each
+    face's angle at corner 0, for the triangles of (V, F)."""
+    return corner_weights(squared_side_lengths(V[F]))
 
 
 @jax.jit
-def _stiffness_and_shape(V, F):
-    P = V[F]
-    return _stiffness(P), _sin2(P)
-
-
-@jax.jit
-def _half_cotangents_and_shape(V, F):
-    """(nf, 3) off-diagonal stiffness entries −K[k+1, k+2] = ½ cot α_k, and `_sin2`."""
-    P = V[F]
-    K = _stiffness(P)
-    return -K[:, jnp.array([1, 2, 0]), jnp.array([2, 0, 1])], _sin2(P)
+def _stiffness_of_positions(V, F):
+    l2 = squared_side_lengths(V[F])
+    return stiffness(l2), corner_weights(l2)[1]
 
 
 def _as_positions(V) -> np.ndarray:
@@ -152,8 +123,6 @@ def checked_triangle_mesh(V, F, *, manifold: bool = False) -> tuple[np.ndarray, 
     V = _as_positions(V)
     F = _as_triangles(F, V.shape[0])
     if manifold:
-        from .mesh.connectivity import from_faces
-
         from_faces(F, n_vertices=V.shape[0])
     return V, F
 
@@ -164,7 +133,7 @@ def triangle_stiffness(V, F) -> np.ndarray:
 
     **Raises:** as `checked_triangle_mesh`, and `DegenerateFaceError` naming a zero-area face.
     """
-    return _per_face(_stiffness_and_shape, V, F)[0]
+    return _per_face(_stiffness_of_positions, V, F)[0]
 
 
 def _per_face(kernel, V, F) -> tuple[np.ndarray, np.ndarray]:
@@ -179,8 +148,7 @@ def _per_face(kernel, V, F) -> tuple[np.ndarray, np.ndarray]:
 def check_nondegenerate(V, F) -> None:
     """Raise `DegenerateFaceError` naming the first face of zero area (sin of its angle at
     corner 0 below ~1e-7), after the checks of `checked_triangle_mesh`."""
-    V, F = checked_triangle_mesh(V, F)
-    _check_areas(np.asarray(_shape(V, F)), F)
+    _per_face(_corner_weights_of_positions, V, F)
 
 
 def _check_areas(sin2, F) -> None:
@@ -195,7 +163,7 @@ def _check_areas(sin2, F) -> None:
 
 def _corner_weights(V, F) -> tuple[np.ndarray, np.ndarray]:
     """Each face's contribution ½ cot α_k to the edge opposite corner k, (nf, 3), and F."""
-    return _per_face(_half_cotangents_and_shape, V, F)
+    return _per_face(_corner_weights_of_positions, V, F)
 
 
 @dataclass(frozen=True, eq=False)
@@ -261,9 +229,33 @@ def _face_edges(F):
     return F[:, [1, 2, 0]].reshape(-1), F[:, [2, 0, 1]].reshape(-1)
 
 
+def laplacian_of_corner_weights(F, w, n_vertices: int) -> sp.csr_matrix:
+    """L = Σ_faces of the stiffness blocks: the Laplacian (nv, nv) csr with the weight w[f, k]
+    (nf, 3) on the side opposite corner k of face f, (L f)_i = Σ_j ν_ij (f_i − f_j) (an
+    interior edge's two faces add up).  The csr structure of F is cached (the last few), for
+    repeated assembly on one connectivity."""
+    return _laplacian(_pattern(F, n_vertices, lambda: _face_edges(F)), np.asarray(w).reshape(-1))
+
+
+def laplacian_of_edge_weights(i, j, w, n_vertices: int) -> sp.csr_matrix:
+    """The Laplacian (nv, nv) csr with the weight w[e] on the edge (i[e], j[e]),
+    (L f)_i = Σ_j ν_ij (f_i − f_j): several edges between two vertices add their weights, loops
+    (i = j) drop out.  Assembled directly (one sort, no cache): for a connectivity used once,
+    such as an intrinsic triangulation after flips."""
+    n = n_vertices
+    index = np.int32 if n < np.iinfo(np.int32).max else np.int64  # scipy's own index type
+    i, j = i.astype(index), j.astype(index)
+    w = np.where(i != j, w, 0.0)
+    diagonal = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
+    vertices = np.arange(n, dtype=index)
+    rows, cols = np.concatenate([i, j, vertices]), np.concatenate([j, i, vertices])
+    return sp.csr_matrix((np.concatenate([-w, -w, diagonal]), (rows, cols)), shape=(n, n))
+
+
 def cotan_laplacian(V, F) -> sp.csr_matrix:
     """The cotan Laplacian (Def 6.2), (nv, nv) csr, positive semidefinite:
-    (L f)_i = Σ_j ν(ij) (f_i − f_j), the autodiff Hessian of the Dirichlet energy (Thm 6.6).
+    (L f)_i = Σ_j ν(ij) (f_i − f_j), the autodiff Hessian of the Dirichlet energy on the squared
+    side lengths of (V, F) (Thm 6.6), assembled by `laplacian_of_corner_weights`.
 
     libigl's `cotmatrix(V, F)` is `−L`.  `V` (nv, 3) or (nv, 2), `F` (nf, 3) int.  The csr
     structure of a connectivity F is computed on first use and cached (the last few F), so that
@@ -272,8 +264,7 @@ def cotan_laplacian(V, F) -> sp.csr_matrix:
     triangle soup is defined; the problem constructors of `energies` check it).
     """
     w, F = _corner_weights(V, F)
-    n = np.shape(V)[0]
-    return _laplacian(_pattern(F, n, lambda: _face_edges(F)), w.reshape(-1))
+    return laplacian_of_corner_weights(F, w, np.shape(V)[0])
 
 
 def cotan_weights(V, F) -> sp.csr_matrix:
@@ -329,88 +320,14 @@ def checked_graph(edges, weights, n_vertices=None) -> tuple[np.ndarray, np.ndarr
     return edges.astype(np.int64), weights, n
 
 
+def face_areas(V, F) -> np.ndarray:
+    """(nf,) A(F) of each triangle from its side lengths (Kahan's Heron, `mesh.lengths`)."""
+    V, F = checked_triangle_mesh(V, F)
+    L = np.sqrt(squared_side_lengths(V[F]))
+    return triangle_area(L[:, 0], L[:, 1], L[:, 2])
+
+
 def barycentric_areas(V, F) -> np.ndarray:
     """(nv,): M_i = ⅓ Σ_{F ∋ i} A(F), the lumped (barycentric) vertex area; −(L f)_i / M_i → Δf."""
     V, F = checked_triangle_mesh(V, F)
-    A = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
-    return np.bincount(F.reshape(-1), np.repeat(A / 3.0, 3), V.shape[0])
-
-
-def boundary_indices(boundary, n_vertices: int) -> np.ndarray:
-    """The boundary vertex set V₀ as sorted unique int64 indices; `boundary` is an index array or
-    a bool mask of length n_vertices.  **Raises:** `InvalidInputError` naming an index outside
-    0..n_vertices−1 or a repeated index, `ShapeError` for a mask of the wrong length."""
-    b = np.array(boundary)
-    if b.dtype == bool:
-        if b.shape != (n_vertices,):
-            raise ShapeError(f"a boundary mask needs shape ({n_vertices},), got {b.shape}")
-        return np.flatnonzero(b).astype(np.int64)
-    b = b.reshape(-1)
-    if b.size and not np.issubdtype(b.dtype, np.integer):
-        raise ShapeError(f"boundary must be vertex indices (integers) or a bool mask, got dtype {b.dtype}")
-    out = np.flatnonzero((b < 0) | (b >= n_vertices))
-    if out.size:
-        raise InvalidInputError(
-            f"boundary vertex {b[out[0]]} (entry {out[0]}) does not exist: vertices are 0..{n_vertices - 1}"
-        )
-    unique, counts = np.unique(b, return_counts=True)
-    if np.any(counts > 1):
-        raise InvalidInputError(f"boundary vertex {unique[counts > 1][0]} is listed more than once")
-    return b.astype(np.int64)
-
-
-def check_unique(L: sp.spmatrix, boundary: np.ndarray) -> None:
-    """Raise `NonUniqueSolutionError` unless every connected component of the graph of L holds a
-    boundary vertex (otherwise constants can be added on it: Cor 6.3), naming a vertex of it."""
-    n_comp, label = connected_components(abs(L) > 0, directed=False)
-    has_boundary = np.zeros(n_comp, dtype=bool)
-    has_boundary[label[boundary]] = True
-    if not has_boundary.all():
-        c = int(np.argmin(has_boundary))
-        v = int(np.argmax(label == c))
-        raise NonUniqueSolutionError(
-            f"the component containing vertex {v} has no boundary vertex: the Dirichlet problem's "
-            "solution is not unique there (any constant can be added, Cor 6.3); add a boundary vertex to it"
-        )
-
-
-def dirichlet_solve(L: sp.spmatrix, boundary, values) -> np.ndarray:
-    """The solution of the discrete Dirichlet boundary value problem (dDBVP, Cor 6.4, Thm 6.5):
-
-        (L f)_i = 0 for i ∉ V₀,   f_i = c_i for i ∈ V₀,
-
-    by one sparse LU factorisation of the interior block, `L_II f_I = −L_IB c`.
-
-    **Arguments:** `L` (nv, nv) sparse; `boundary` V₀ (indices, or a bool mask); `values` c,
-    (nb,) or (nb, k) for k right-hand sides (e.g. the coordinates of a surface, Fig 6.5),
-    ordered like `boundary` (like its True entries for a mask).
-    **Returns:** f, (nv,) or (nv, k).
-    **Raises:** `InvalidInputError` for a boundary index that does not exist, `NonFiniteError`
-    for NaN values, `NonUniqueSolutionError` when a component has no boundary vertex or the
-    interior block is singular (possible with negative weights).
-    """
-    L = sp.csr_matrix(L)
-    n = L.shape[0]
-    b = boundary_indices(boundary, n)
-    c = np.array(values, dtype=np.float64)
-    if c.shape[:1] != (b.size,) or c.ndim > 2:
-        raise ShapeError(f"values must have shape ({b.size},) or ({b.size}, k), one row per boundary vertex, got {c.shape}")
-    check_finite(c, "values")
-    check_unique(L, b)
-    interior = np.ones(n, dtype=bool)
-    interior[b] = False
-    inner = np.flatnonzero(interior)
-    f = np.zeros((n,) + c.shape[1:])
-    f[b] = c
-    if inner.size == 0:
-        return f
-    rows = L[inner]
-    try:
-        lu = splu(rows[:, inner].tocsc(), permc_spec="MMD_AT_PLUS_A")
-    except RuntimeError as err:
-        raise NonUniqueSolutionError(
-            f"the interior block of the Laplacian is singular ({err}): the Dirichlet problem has no unique "
-            "solution (possible with negative weights, eq 6.3)"
-        ) from None
-    f[inner] = lu.solve(-(rows[:, b] @ c))
-    return f
+    return np.bincount(F.reshape(-1), np.repeat(face_areas(V, F) / 3.0, 3), V.shape[0])

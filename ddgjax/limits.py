@@ -56,24 +56,11 @@ class ConvergenceTable:
         return "\n".join(lines)
 
     def plot(self, path, *, title: str | None = None):
-        """Log-log plot of the errors with a reference slope of the fitted order; saves `path`."""
-        import matplotlib
+        """Log-log plot of the errors with a reference slope of the fitted order; saves `path`
+        (drawn by `ddgjax.plot.convergence`)."""
+        from .plot.lines import convergence as draw  # output layer, loaded on use
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(4.5, 3.5))
-        ax.loglog(self.ns, self.errors, "o-", label=self.label)
-        ref = self.errors[0] * (self.ns / self.ns[0]) ** (-self.fitted_order)
-        ax.loglog(self.ns, ref, "--", color="gray", label=f"slope −{self.fitted_order:.2f}")
-        ax.set_xlabel("n")
-        ax.set_ylabel(self.label)
-        ax.set_title(title or f"fitted order {self.fitted_order:.2f}")
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return path
+        return draw(self, path, title=title)
 
 
 def _validate(ns: np.ndarray, errors: np.ndarray) -> None:

@@ -15,12 +15,15 @@ sparsity of the Hessian and of the constraint Jacobian *without detection*
 finite-element assembly.  A `Local` object is itself a valid `energy(x, params)` or
 `constraints(x, params)` callable, so the dense path and every flow work on it unchanged.
 
+Constraints may be named, `concat(unit=local_map(...), chord=local_sum(...))`: the declaration
+then returns a dict and `solve` returns the multipliers under the same names.
+
 The unknown `x` of a local problem is a single array of shape (N, d) or (N,).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import jax
@@ -69,35 +72,49 @@ class Local:
     """Groups of `Term`s: terms within a group are summed, groups are concatenated.
 
     An energy is one group (`local_sum(a) + local_sum(b)`); constraints may be several
-    (`concat(local_map(unit_length, cells), local_sum(chord, cells))`).
+    (`concat(local_map(unit_length, cells), local_sum(chord, cells))`).  With `names` (one per
+    group, sorted; consecutive groups may share a name) the call returns a dict `{name: output}`
+    and the groups are stored in sorted-name order, which is JAX's order of the dict's leaves:
+    the flat constraint vector is the groups' outputs concatenated in that order either way.
     """
 
     groups: tuple[tuple[Term, ...], ...]
+    names: tuple[str, ...] | None = None
+    hash_value: int = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        # the declaration is immutable: its hash (over the stencils' bytes) is computed once
+        object.__setattr__(self, "hash_value", hash(self.key()))
 
     def __call__(self, x, params=None):
         x = jnp.asarray(x)
         outs = [sum(term(x, params) for term in group) for group in self.groups]
-        if len(outs) == 1:
-            return outs[0]
-        return jnp.concatenate([jnp.ravel(o) for o in outs])
+        if self.names is None:
+            return _joined(outs)
+        return {name: _joined([o for o, n in zip(outs, self.names) if n == name]) for name in dict.fromkeys(self.names)}
 
     def __add__(self, other: "Local") -> "Local":
         if not isinstance(other, Local) or len(self.groups) != 1 or len(other.groups) != 1:
             return NotImplemented
+        if self.names is not None or other.names is not None:
+            return NotImplemented
         return Local((self.groups[0] + other.groups[0],))
 
     def key(self) -> tuple:
-        return tuple(tuple(term.key() for term in group) for group in self.groups)
+        return (tuple(tuple(term.key() for term in group) for group in self.groups), self.names)
 
     def __hash__(self):
-        try:
-            return self._hash
-        except AttributeError:
-            object.__setattr__(self, "_hash", hash(self.key()))
-            return self._hash
+        return self.hash_value
 
     def __eq__(self, other):
         return isinstance(other, Local) and self.key() == other.key()
+
+
+def _joined(outs: list) -> Array:
+    """One group's output as it is; several groups' outputs raveled and concatenated."""
+    if len(outs) == 1:
+        return outs[0]
+    return jnp.concatenate([jnp.ravel(o) for o in outs])
 
 
 def _as_stencil(stencil, name: str) -> np.ndarray:
@@ -144,9 +161,32 @@ def local_map(fn: Callable, stencil: Int[np.ndarray, "K s"], data=None) -> Local
     return Local(((Term(fn, s, _as_data(data, len(s), "local_map"), "map"),),))
 
 
-def concat(*parts: Local) -> Local:
-    """Concatenate the outputs of several local constraint declarations, in order."""
-    for i, part in enumerate(parts):
+def concat(*parts: Local, **named: Local) -> Local:
+    """Concatenate several local constraint declarations: positionally, in order, into one
+    1-D constraint vector; or by keyword, `concat(unit=local_map(...), chord=local_sum(...))`,
+    into named constraints, a dict `{"chord": ..., "unit": ...}` whose multipliers
+    `solve(...).multipliers` carries under the same names.
+
+    The constraint vector of a named declaration is its leaves concatenated in sorted-name
+    order (JAX's order of a dict's leaves), and the groups are stored in that order, so the
+    solvers see the same flat vector as for the positional declaration in sorted order.
+
+    **Raises:** `InvalidInputError` for an argument that is not a local declaration, for
+    positional and keyword arguments together, or for a keyword argument that is itself named.
+    """
+    if parts and named:
+        raise InvalidInputError("concat: give the parts either all by position or all by name, not both")
+    for label, part in [(f"argument {i}", p) for i, p in enumerate(parts)] + [(f"{k}=", p) for k, p in named.items()]:
         if not isinstance(part, Local):
-            raise InvalidInputError(f"concat: argument {i} is {type(part).__name__}, not a local declaration")
-    return Local(tuple(group for part in parts for group in part.groups))
+            raise InvalidInputError(f"concat: {label} is {type(part).__name__}, not a local declaration")
+    if not named:
+        if any(part.names is not None for part in parts):
+            raise InvalidInputError("concat: a named declaration cannot be concatenated by position; name every part")
+        return Local(tuple(group for part in parts for group in part.groups))
+    for name, part in named.items():
+        if part.names is not None:
+            raise InvalidInputError(f"concat: {name}= is itself named ({list(dict.fromkeys(part.names))}); nest no names")
+    ordered = sorted(named)
+    groups = tuple(group for name in ordered for group in named[name].groups)
+    names = tuple(name for name in ordered for _ in named[name].groups)
+    return Local(groups, names)

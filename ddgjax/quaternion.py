@@ -34,6 +34,9 @@ from ._checks import check_finite, is_concrete
 from .errors import InvalidInputError, ShapeError
 
 __all__ = [
+    "as_quaternion",
+    "as_vector",
+    "check_unit",
     "mul",
     "conj",
     "norm",
@@ -81,11 +84,14 @@ def _as_array(x, name: str, size: int, noun: str) -> Array:
     return jnp.asarray(x, dtype=float)
 
 
-def _as_quaternion(q, name: str = "q") -> Quaternion:
+def as_quaternion(q, name: str = "q") -> Quaternion:
+    """`q` as a float array [..., 4]; **Raises:** `ShapeError` naming `name`, `NonFiniteError`
+    (concrete q) naming the entry."""
     return _as_array(q, name, 4, "quaternions, real part first")
 
 
-def _as_vector(v, name: str = "v") -> Vector:
+def as_vector(v, name: str = "v") -> Vector:
+    """`v` as a float array [..., 3]; raises as `as_quaternion`."""
     return _as_array(v, name, 3, "vectors of R³ = Im H")
 
 
@@ -129,7 +135,7 @@ def mul(p: Quaternion, q: Quaternion) -> Quaternion:
 
     Broadcasts over leading axes.  **Raises:** `ShapeError`, `NonFiniteError`.
     """
-    return _mul(_as_quaternion(p, "p"), _as_quaternion(q, "q"))
+    return _mul(as_quaternion(p, "p"), as_quaternion(q, "q"))
 
 
 def _conj(q: Array) -> Array:
@@ -138,12 +144,12 @@ def _conj(q: Array) -> Array:
 
 def conj(q: Quaternion) -> Quaternion:
     """`q̄ = Re q − Im q`."""
-    return _conj(_as_quaternion(q))
+    return _conj(as_quaternion(q))
 
 
 def norm(q: Quaternion) -> Float[Array, "..."]:
     """`|q| = sqrt(q q̄)`, the Euclidean norm of R⁴ (multiplicative: |pq| = |p||q|)."""
-    return jnp.linalg.norm(_as_quaternion(q), axis=-1)
+    return jnp.linalg.norm(as_quaternion(q), axis=-1)
 
 
 def _inv(q: Array) -> Array:
@@ -152,20 +158,20 @@ def _inv(q: Array) -> Array:
 
 def inv(q: Quaternion) -> Quaternion:
     """`q⁻¹ = q̄ / |q|²`.  **Raises:** `InvalidInputError` for q = 0 (naming the index)."""
-    q = _as_quaternion(q)
+    q = as_quaternion(q)
     _check_nonzero(q, "q")
     return _inv(q)
 
 
 def from_vector(v: Vector) -> Quaternion:
     """The imaginary quaternion `v1 i + v2 j + v3 k` of `v ∈ R³`."""
-    v = _as_vector(v)
+    v = as_vector(v)
     return jnp.concatenate([jnp.zeros_like(v[..., :1]), v], axis=-1)
 
 
 def to_vector(q: Quaternion) -> Vector:
     """`Im q` as a vector of R³ (the real part is dropped)."""
-    return _as_quaternion(q)[..., 1:]
+    return as_quaternion(q)[..., 1:]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -187,9 +193,9 @@ def rotate(q: Quaternion, v: Vector) -> Vector:
     Any q ≠ 0 is allowed (|q| cancels, footnote 17); broadcasts q [..., 4] against v [..., 3].
     **Raises:** `ShapeError`, `NonFiniteError`, `InvalidInputError` (q = 0).
     """
-    q = _as_quaternion(q)
+    q = as_quaternion(q)
     _check_nonzero(q, "q")
-    return _rotate(q, _as_vector(v))
+    return _rotate(q, as_vector(v))
 
 
 def _safe_norm(v: Array) -> Array:
@@ -206,7 +212,7 @@ def from_axis_angle(axis: Vector, angle) -> Quaternion:
     **Arguments:** `axis` [..., 3] (any length ≠ 0), `angle` [...] (radians); broadcast.
     **Raises:** `ShapeError`, `NonFiniteError`, `InvalidInputError` (a zero axis, naming it).
     """
-    axis = _as_vector(axis, "axis")
+    axis = as_vector(axis, "axis")
     if is_concrete(axis):
         zero = np.all(np.asarray(axis) == 0, axis=-1)
         if np.any(zero):
@@ -237,7 +243,7 @@ def to_matrix(q: Quaternion) -> Float[Array, "... 3 3"]:
     """The rotation matrix `R_q ∈ SO(3)` with `R_q v = q v q⁻¹`; its columns are the images of
     e1, e2, e3 (the frame (T, N, B) of Def 3.4).  Any q ≠ 0 (|q| cancels).
     **Raises:** `ShapeError`, `NonFiniteError`, `InvalidInputError` (q = 0)."""
-    q = _as_quaternion(q)
+    q = as_quaternion(q)
     _check_nonzero(q, "q")
     return _matrix(q)
 
@@ -311,7 +317,7 @@ def exp(v: Vector) -> Quaternion:
 
     `exp(θ/2 · n)` rotates by θ about n; `exp(t a/2)` solves `q' = ½ a q`, q(0) = 1.
     """
-    return _exp(_as_vector(v))
+    return _exp(as_vector(v))
 
 
 def _log(q: Array) -> Array:
@@ -329,7 +335,7 @@ def log(q: Quaternion, *, tol: float = UNIT_TOL) -> Vector:
     The sign of q is chosen with `q0 ≥ 0` (the rotation angle 2|v| ∈ [0, π]).
     **Raises:** `InvalidInputError` when a concrete q is not unit (naming the entry), and as `mul`.
     """
-    q = _as_quaternion(q)
+    q = as_quaternion(q)
     check_unit(q, "q", tol)
     return _log(jnp.where(q[..., :1] < 0, -q, q))
 
@@ -351,13 +357,13 @@ def identity_motion() -> Motion:
 
 def _as_motion(m, name: str) -> Motion:
     q, p = m
-    return Motion(_as_quaternion(q, name + ".q"), _as_vector(p, name + ".p"))
+    return Motion(as_quaternion(q, name + ".q"), as_vector(p, name + ".p"))
 
 
 def apply(m: Motion, v: Vector) -> Vector:
     """`m(v) = q v q⁻¹ + p`."""
     q, p = _as_motion(m, "m")
-    return _rotate(q, _as_vector(v)) + p
+    return _rotate(q, as_vector(v)) + p
 
 
 def compose(m2: Motion, m1: Motion) -> Motion:
@@ -377,7 +383,7 @@ def inverse(m: Motion) -> Motion:
 
 def infinitesimal_motion(a: Vector, b: Vector, v: Vector) -> Vector:
     """Cor 3.7: the velocity `½[a, v] + b = a × v + b` of the point v."""
-    return jnp.cross(_as_vector(a, "a"), _as_vector(v)) + _as_vector(b, "b")
+    return jnp.cross(as_vector(a, "a"), as_vector(v)) + as_vector(b, "b")
 
 
 def generator(m: Motion, m_dot: Motion) -> tuple[Vector, Vector]:
@@ -393,7 +399,7 @@ def motion_ode(a: Vector, b: Vector, m: Motion) -> Motion:
     """The right-hand side `(q', p') = (½ a q, b + ½[a, p])` whose flow is generated by the
     infinitesimal motion `v ↦ a × v + b` (Section 3.2.1, after Cor 3.7)."""
     q, p = _as_motion(m, "m")
-    a, b = _as_vector(a, "a"), _as_vector(b, "b")
+    a, b = as_vector(a, "a"), as_vector(b, "b")
     return Motion(0.5 * _mul(jnp.concatenate([jnp.zeros_like(a[..., :1]), a], axis=-1), q), b + jnp.cross(a, p))
 
 
@@ -412,7 +418,7 @@ def motion_exp(a: Vector, b: Vector, t=1.0) -> Motion:
     series for ωt < 0.1, so ω → 0 gives the translation t b).  The flow from m0 is
     `compose(motion_exp(a, b, t), m0)`.
     """
-    a, b = _as_vector(a, "a"), _as_vector(b, "b")
+    a, b = as_vector(a, "a"), as_vector(b, "b")
     t = jnp.asarray(t, dtype=float)[..., None]
     w = _safe_norm(a)
     x = w * t

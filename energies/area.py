@@ -7,11 +7,19 @@ Laplacian of the surface applied to its own positions, ∇_{f(i)} A = (L f)(i). 
 for the area (a simplicial minimal surface in the wide sense, [PP93]) iff its coordinates are
 harmonic for its own cotan Laplacian, L f = 0 at the interior vertices.
 
-**Algorithms** (`minimal_surface`):
+**Algorithms** (`minimal_surface`), all but Newton one loop, `harmonic_iteration`:
 - `method="cotan"`: Fig 6.5, the Pinkall–Polthier iteration: solve the Dirichlet problem of the
   cotan Laplacian of the current surface with the boundary fixed (one sparse LU, three right-hand
-  sides) and replace the surface by the solution, until the area gradient at the interior
-  vertices is below `tol` (max-norm, the KKT residual of `simplicial`).
+  sides, `dirichlet.dirichlet_solve`) and replace the surface by the solution, until the area
+  gradient at the interior vertices is below `tol` (max-norm, the KKT residual of `simplicial`).
+- `method="delaunay"`: Fig 7.23, minimal surfaces in the narrow sense (Def 7.9): the same
+  iteration, but each step first makes the triangulation intrinsically Delaunay by edge flips
+  and solves with its Laplace–Beltrami operator, keeping the new combinatorics; it stops when the
+  triangulation is Delaunay for the current surface and the residual is below `tol`.  Then S is
+  critical for the area (Thm 6.7, Remark 7.10) and, all weights being ≥ 0, every interior vertex
+  lies in the convex hull of its neighbours (maximum principle, Prop 6.8).  The surface is
+  carried as a gluing (`ddgjax.intrinsic.Triangulation`), so the flipped triangulations may be
+  Δ-complexes.
 - `method="newton"`: `solvers.solve` on `simplicial(...)`: Newton on ∇A = 0 with the Hessian by
   autodiff (quadratic convergence from a start close enough).
 
@@ -19,58 +27,53 @@ In practice Fig 6.5 brings the area gradient down fast to ~1e-5 (for O(1) surfac
 creeps: the remaining motion is mostly tangential and contracts by ~1 % per step on the catenoid
 of `tests/test_area.py`.  Newton started from such an iterate converges in two or three steps;
 started from a coarse guess (the cylinder) it does not (area is not convex).  So: `"cotan"` to a
-loose `tol`, then `"newton"` from its result.
-- `method="delaunay"`: Fig 7.23, the same iteration with the intrinsic Laplace–Beltrami operator
-  and edge flips, `ddgjax.intrinsic.minimal.minimal_surface_delaunay` (issue 7).
+loose `tol`, then `"newton"` from its result.  From a start with skinny triangles Fig 6.5 may
+degenerate where Fig 7.23 converges (Fig 7.26).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from jaxtyping import Array, Float
-from scipy.optimize import brentq
 
 import ddgjax as dg
-from ddgjax.errors import ConvergenceError, InvalidInputError
+from ddgjax import intrinsic
+from ddgjax.errors import ConvergenceError, DDGError, InvalidInputError
 from ddgjax.laplace import (
-    barycentric_areas,
-    boundary_indices,
     check_nondegenerate,
     checked_triangle_mesh,
     cotan_laplacian,
-    dirichlet_solve,
-    triangle_area,
+    face_areas,
 )
+from ddgjax.mesh import boundary_indices, boundary_vertices
+from ddgjax.mesh.lengths import squared_side_lengths, triangle_area
 
-__all__ = ["METHODS", "catenoid_neck", "face_area", "mesh_boundary", "minimal_surface", "neck_radius", "pinkall_polthier_step", "simplicial"]
+from .dirichlet import dirichlet_solve
+
+__all__ = ["METHODS", "face_area", "harmonic_iteration", "interior_residual", "minimal_surface",
+           "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial"]
 
 METHODS = ("cotan", "newton", "delaunay")
 
 
 def face_area(P: Float[Array, "3 3"], params=None) -> Float[Array, ""]:
-    """½ |(v1 − v0) × (v2 − v0)|: one face's area (the density of `simplicial`)."""
-    return triangle_area(P)
-
-
-def mesh_boundary(F, n_vertices: int) -> np.ndarray:
-    """Indices of the vertices on boundary edges of F (the default fixed set)."""
-    from ddgjax.mesh.connectivity import from_faces
-    from ddgjax.mesh.curvature import boundary_vertex_mask
-
-    return np.flatnonzero(boundary_vertex_mask(from_faces(F, n_vertices=n_vertices)))
+    """A(F) of one face from its side lengths (Kahan's Heron, `ddgjax.mesh.lengths`): the density
+    of `simplicial`."""
+    l = squared_side_lengths(P) ** 0.5
+    return triangle_area(l[0], l[1], l[2])
 
 
 def _checked(V, F, boundary) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     V, F = checked_triangle_mesh(V, F, manifold=True)
     check_nondegenerate(V, F)
-    b = mesh_boundary(F, V.shape[0]) if boundary is None else boundary_indices(boundary, V.shape[0])
+    b = boundary_vertices(F, V.shape[0]) if boundary is None else boundary_indices(boundary, V.shape[0])
     return V, F, b
 
 
 def simplicial(V, F, boundary=None) -> dg.Problem:
-    """The area A(S) = Σ_F ½|(v1 − v0) × (v2 − v0)| of the triangle mesh (V, F) as a functional
-    of the vertex positions (nv, 3), with the vertices `boundary` fixed (default: the vertices on
-    boundary edges of F).  Its critical points are simplicial minimal surfaces (Thm 6.7).
+    """The area A(S) = Σ_F A(F) of the triangle mesh (V, F) as a functional of the vertex
+    positions (nv, 3), with the vertices `boundary` fixed (default: the vertices on boundary
+    edges of F).  Its critical points are simplicial minimal surfaces (Thm 6.7).
 
     **Raises:** `NonFiniteError` (NaN position, naming the vertex), `DegenerateFaceError` (a
     zero-area face, where the area is not differentiable), `MeshError` / `NonManifoldError`
@@ -82,6 +85,23 @@ def simplicial(V, F, boundary=None) -> dg.Problem:
     return dg.Problem(dg.local_sum(face_area, F), V, fixed=fixed, name=f"simplicial area (nv={len(V)}, nf={len(F)})")
 
 
+def interior_residual(L, V, fixed: np.ndarray) -> float:
+    """max over the free vertices of |(Δ f)(i)|, the area gradient ∇_{f(i)} A (Thm 6.7)."""
+    return float(np.max(np.abs((L @ V)[~fixed]), initial=0.0))
+
+
+def _harmonic_step(L, V: np.ndarray, boundary: np.ndarray, fixed: np.ndarray) -> tuple[np.ndarray, float]:
+    """`(Ṽ, r)`: Ṽ harmonic for L with Ṽ = V on `boundary` (`dirichlet_solve`), and r the area
+    gradient at V (`interior_residual`)."""
+    return dirichlet_solve(L, boundary, V[boundary]), interior_residual(L, V, fixed)
+
+
+def _mask(boundary: np.ndarray, n: int) -> np.ndarray:
+    fixed = np.zeros(n, dtype=bool)
+    fixed[boundary] = True
+    return fixed
+
+
 def pinkall_polthier_step(V, F, boundary) -> tuple[np.ndarray, float]:
     """One step of Fig 6.5: `(Ṽ, r)` with Ṽ harmonic for the cotan Laplacian L of (V, F), Ṽ = V on
     `boundary`, and r = max |(L V)_i| over the interior vertices, the area gradient at V (Thm 6.7).
@@ -89,24 +109,98 @@ def pinkall_polthier_step(V, F, boundary) -> tuple[np.ndarray, float]:
     **Raises:** `DegenerateFaceError` when a face of (V, F) has zero area.
     """
     V = np.asarray(V, dtype=np.float64)
-    L = cotan_laplacian(V, F)
-    interior = np.ones(len(V), dtype=bool)
-    interior[boundary] = False
-    gradient = L @ V
-    residual = float(np.max(np.abs(gradient[interior]))) if interior.any() else 0.0
-    return dirichlet_solve(L, boundary, V[boundary]), residual
+    b = boundary_indices(boundary, len(V))
+    return _harmonic_step(cotan_laplacian(V, F), V, b, _mask(b, len(V)))
 
 
-def _cotan_iteration(V, F, b, tol, max_iter):
-    residuals, areas = [], []
-    for _ in range(max_iter + 1):
-        V_next, residual = pinkall_polthier_step(V, F, b)
-        residuals.append(residual)
-        areas.append(float(barycentric_areas(V, F).sum()))
-        if residual <= tol:
+def _surface_laplacian(V, F, delaunay_tol):
+    """Fig 6.5: the cotan Laplacian of the simplicial surface (V, F), its area, no flips."""
+    return cotan_laplacian(V, F), F, float(face_areas(V, F).sum()), 0
+
+
+def _delaunay_laplacian(V, tri, delaunay_tol):
+    """Fig 7.23: the gluing `tri` with the lengths of V, made Delaunay by flips; its cotan
+    Laplacian (the Laplace–Beltrami operator), the area, the number of flips."""
+    i, j = tri.edges.T
+    tri = tri.with_lengths(np.linalg.norm(V[j] - V[i], axis=1))
+    L = intrinsic.triangulation.side_lengths(tri)
+    area = float(triangle_area(L[:, 0], L[:, 1], L[:, 2]).sum())
+    result = intrinsic.flip_to_delaunay(tri, tol=delaunay_tol, record_history=False)
+    return intrinsic.cotan_laplacian(result.triangulation), result.triangulation, area, result.n_flips
+
+
+def harmonic_iteration(V, F, boundary=None, *, flip: bool, tol: float = 1e-10, max_iter: int = 1000,
+                       delaunay_tol: float = intrinsic.delaunay.DELAUNAY_TOL, throw: bool = False):
+    """Iterate S ← S̃ with Δ_{S,T} f̃ = 0, the boundary vertices fixed: Fig 6.5 for `flip=False`
+    (Δ the cotan Laplacian of the surface S), Fig 7.23 for `flip=True` (T first made
+    intrinsically Delaunay by edge flips, Δ its Laplace–Beltrami operator, Def 7.9).
+
+    **Arguments:** `V` (nv, 3), `F` (nf, 3) (or, with `flip=True`, a `Triangulation` carrying the
+    gluing); `boundary` fixed vertex indices or an (nv,) bool mask (default: the vertices on
+    boundary edges); `tol` on the interior residual max |Δf(i)| = |∇_{f(i)} A| (Thm 6.7);
+    `max_iter` the iteration budget; `delaunay_tol` the tie tolerance of the flips; `throw`
+    raise `ConvergenceError` when not converged.
+
+    **Returns:** `(V, F, info)`, info with `method`, `converged`, `iterations`, `history` (the
+    residual at each iterate, measured before its step), `residual` (the last), `flips` (per
+    iterate), `area` (of each iterate, the simplicial surface before flipping), `triangulation`
+    (the final gluing; None for `flip=False`).  An iterate with a degenerate triangle (the
+    iteration broke down) ends the run, not converged.
+
+    **Raises:** the errors of `intrinsic.from_mesh` (`flip=True`) or `simplicial`;
+    `ConvergenceError` (with `throw`).
+    """
+    V = np.array(V, dtype=np.float64)
+    if flip:
+        carrier = F if isinstance(F, intrinsic.Triangulation) else intrinsic.from_mesh(V, F)
+        laplacian = _delaunay_laplacian
+        default = np.flatnonzero(carrier.connectivity.boundary_vertex_mask)
+    else:
+        V, carrier, default = _checked(V, F, None)
+        laplacian = _surface_laplacian
+    b = default if boundary is None else boundary_indices(boundary, len(V))
+    fixed = _mask(b, len(V))
+    history, flips, areas, breakdown = [], [], [], None
+    for k in range(max_iter + 1):
+        try:
+            L, carrier, area, n_flips = laplacian(V, carrier, delaunay_tol)
+        except DDGError as error:
+            breakdown = error
+            break
+        V_next, residual = _harmonic_step(L, V, b, fixed)
+        areas.append(area)
+        history.append(residual)
+        flips.append(n_flips)
+        if (n_flips == 0 and residual <= tol) or k == max_iter:
             break
         V = V_next
-    return V, {"iterations": len(residuals) - 1, "history": np.array(residuals), "area": np.array(areas)}
+    info = _report(flip, history, flips, areas, breakdown, tol)
+    info["triangulation"] = carrier if flip else None
+    if throw and not info["converged"]:
+        reason = f"the iteration broke down ({breakdown})" if breakdown else (
+            f"residual {info['residual']:.3e} > tol {tol:.1e} or still flipping after {info['iterations']} iterations")
+        raise ConvergenceError(f"harmonic iteration (Fig {'7.23' if flip else '6.5'}) did not converge: {reason}; "
+                               "raise max_iter or tol, or start closer",
+                               residual=float(info["residual"]), steps=info["iterations"])
+    return V, carrier.F if flip else carrier, info
+
+
+def _report(flip, history, flips, areas, breakdown, tol) -> dict:
+    residual = history[-1] if history else np.inf
+    converged = breakdown is None and bool(flips) and flips[-1] == 0 and residual <= tol
+    return {"method": "delaunay" if flip else "cotan", "converged": converged, "iterations": max(len(history) - 1, 0),
+            "history": np.array(history), "residual": float(residual), "flips": np.array(flips, dtype=np.int64),
+            "area": np.array(areas), "breakdown": breakdown}
+
+
+def minimal_surface_delaunay(V, F, boundary=None, *, tol: float = 1e-10, max_iter: int = 1000,
+                             delaunay_tol: float = intrinsic.delaunay.DELAUNAY_TOL, throw: bool = True):
+    """Minimal surface in the narrow sense by the algorithm of Fig 7.23 (Def 7.9):
+    `harmonic_iteration(..., flip=True)`.  The returned F is the final (Delaunay) triangulation,
+    possibly with other combinatorics than the input (a face may repeat a vertex if the surface
+    degenerates)."""
+    return harmonic_iteration(V, F, boundary, flip=True, tol=tol, max_iter=max_iter,
+                              delaunay_tol=delaunay_tol, throw=throw)
 
 
 def _newton(V, F, b, tol, max_iter, solve_method="auto", **kwargs):
@@ -114,18 +208,9 @@ def _newton(V, F, b, tol, max_iter, solve_method="auto", **kwargs):
 
     sol = solve(simplicial(V, F, b), tol=tol, max_steps=max_iter, throw=False, method=solve_method, **kwargs)
     info = {"iterations": int(sol.steps), "history": np.asarray(sol.history), "area": np.array([float(sol.energy)])}
-    return np.asarray(sol.x), info
-
-
-def _delaunay(V, F, boundary, tol, max_iter, throw, **kwargs):
-    try:
-        from ddgjax.intrinsic.minimal import minimal_surface_delaunay
-    except ImportError:
-        raise NotImplementedError(
-            "method='delaunay' (Fig 7.23) needs ddgjax.intrinsic.minimal.minimal_surface_delaunay "
-            "(issue 7), which this installation does not have yet; use method='cotan' or 'newton'"
-        ) from None
-    return minimal_surface_delaunay(V, F, boundary, tol=tol, max_iter=max_iter, throw=throw, **kwargs)
+    info.update(method="newton", residual=float(info["history"][-1]))
+    info["converged"] = info["residual"] <= tol
+    return np.asarray(sol.x), F, info
 
 
 def minimal_surface(V, F, boundary=None, *, method: str = "cotan", tol: float = 1e-10,
@@ -133,32 +218,30 @@ def minimal_surface(V, F, boundary=None, *, method: str = "cotan", tol: float = 
     """A simplicial minimal surface spanned by the fixed `boundary` vertices of (V, F), started
     from V: `(V_min, F, info)`.
 
-    **Arguments:** `method` `"cotan"` (Fig 6.5, Pinkall–Polthier), `"newton"` (`solvers.solve`
-    on `simplicial`; `solve_method=` is solve's `method`, other `kwargs` go to `solve`) or
-    `"delaunay"` (Fig 7.23; `kwargs` go to `ddgjax.intrinsic.minimal.minimal_surface_delaunay`,
-    which returns the result); `tol`: stop when the max-norm of the area gradient at the
-    interior vertices is `<= tol` (Fig 6.5 gets to ~1e-5 fast and then creeps: module docstring);
-    `max_iter`: iterations (Newton steps); `throw`: raise `ConvergenceError` if not converged.
+    **Arguments:** `method` `"cotan"` (Fig 6.5, Pinkall–Polthier), `"delaunay"` (Fig 7.23, a
+    minimal surface in the narrow sense; `delaunay_tol=` the flips' tie tolerance) or `"newton"`
+    (`solvers.solve` on `simplicial`; `solve_method=` is solve's `method`, other `kwargs` go to
+    `solve`); `tol`: stop when the max-norm of the area gradient at the interior vertices is
+    `<= tol` (Fig 6.5 gets to ~1e-5 fast and then creeps: module docstring); `max_iter`:
+    iterations (Newton steps); `throw`: raise `ConvergenceError` if not converged.
 
-    **Returns:** `V_min` (nv, 3), `F`, and `info` with `method`, `iterations`, `history` (the
-    area-gradient residual at each iterate), `area` (at each iterate, or the final one),
-    `residual` (the last), `converged`.
+    **Returns:** `V_min` (nv, 3), `F` (for `"delaunay"` the final triangulation), and `info` as
+    `harmonic_iteration` (Newton: `method`, `iterations`, `history`, `area`, `residual`,
+    `converged`).
 
-    **Raises:** `InvalidInputError` (unknown method), the errors of `simplicial`,
-    `DegenerateFaceError` when an iterate has a zero-area face, `ConvergenceError`,
-    `NotImplementedError` for `"delaunay"` while issue 7's function is missing.
+    **Raises:** `InvalidInputError` (unknown method or option), the errors of `simplicial`,
+    `ConvergenceError` (not converged, or an iterate degenerated).
     """
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
-    if method == "delaunay":
-        return _delaunay(V, F, boundary, tol, max_iter, throw, **kwargs)
-    if kwargs and method == "cotan":
-        raise InvalidInputError(f"method='cotan' takes no further options, got {sorted(kwargs)}")
-    V, F, b = _checked(V, F, boundary)
-    run = _cotan_iteration if method == "cotan" else _newton
-    V_min, info = run(V, F, b, float(tol), int(max_iter), **kwargs)
-    info.update(method=method, residual=float(info["history"][-1]))
-    info["converged"] = info["residual"] <= tol
+    if method == "newton":
+        V, F, b = _checked(V, F, boundary)
+        V_min, F, info = _newton(V, F, b, float(tol), int(max_iter), **kwargs)
+    else:
+        if set(kwargs) - {"delaunay_tol"} or (kwargs and method == "cotan"):
+            raise InvalidInputError(f"method={method!r} takes no further options, got {sorted(kwargs)}")
+        return harmonic_iteration(V, F, boundary, flip=method == "delaunay", tol=float(tol), max_iter=int(max_iter),
+                                  throw=throw, **kwargs)
     if throw and not info["converged"]:
         raise ConvergenceError(
             f"minimal_surface(method={method!r}) did not converge: area-gradient residual "
@@ -167,15 +250,3 @@ def minimal_surface(V, F, boundary=None, *, method: str = "cotan", tol: float = 
             residual=info["residual"], steps=info["iterations"],
         )
     return V_min, F, info
-
-
-def catenoid_neck(R: float = 1.0, H: float = 0.5) -> float:
-    """The neck radius c of the stable catenoid r(z) = c cosh(z/c) through the circles of radius R
-    at z = ±H: the larger root of c cosh(H/c) = R (the smaller one is the unstable catenoid)."""
-    fold = brentq(lambda c: np.tanh(H / c) - c / H, 1e-3 * H, H)  # c cosh(H/c) is least here
-    return brentq(lambda c: c * np.cosh(H / c) - R, fold, R)
-
-
-def neck_radius(V) -> float:
-    """min over the vertices of the distance to the z-axis."""
-    return float(np.min(np.linalg.norm(np.asarray(V)[:, :2], axis=1)))

@@ -14,27 +14,30 @@ positions (`dg.laplace.triangle_dirichlet_energy`); its Hessian is the cotan Lap
 
 Both problems are quadratic, so `solvers.solve` finishes in one Newton step; `graph_sparse` and
 `cotan_sparse` take the same arguments and solve the same linear system directly with one sparse
-LU factorisation of the interior block (`dg.laplace.dirichlet_solve`).
+LU factorisation of the interior block (`dirichlet_solve`, for any Laplacian: also the harmonic
+iterations of `energies.area`).
 """
 
 from __future__ import annotations
 
 import jax.numpy as jnp
 import numpy as np
+import scipy.sparse as sp
 from jaxtyping import Array, Float
+from scipy.sparse.csgraph import connected_components
+from scipy.sparse.linalg import splu
 
 import ddgjax as dg
 from ddgjax._checks import check_finite
-from ddgjax.errors import ShapeError
+from ddgjax.errors import NonUniqueSolutionError, ShapeError
 from ddgjax.laplace import (
-    boundary_indices,
-    check_unique,
     checked_graph,
     checked_triangle_mesh,
     triangle_dirichlet_energy,
 )
+from ddgjax.mesh import boundary_indices
 
-__all__ = ["cotan", "cotan_sparse", "edge_energy", "graph", "graph_sparse"]
+__all__ = ["check_unique", "cotan", "cotan_sparse", "dirichlet_solve", "edge_energy", "graph", "graph_sparse"]
 
 
 def edge_energy(f2: Float[Array, "2"], weight: Float[Array, ""]) -> Float[Array, ""]:
@@ -111,12 +114,70 @@ def cotan(V, F, boundary, values) -> dg.Problem:
     return _problem(energy, params, L, V.shape[0], boundary, values, name)
 
 
+def check_unique(L: sp.spmatrix, boundary: np.ndarray) -> None:
+    """Raise `NonUniqueSolutionError` unless every connected component of the graph of L holds a
+    boundary vertex (otherwise constants can be added on it: Cor 6.3), naming a vertex of it."""
+    n_comp, label = connected_components(abs(L) > 0, directed=False)
+    has_boundary = np.zeros(n_comp, dtype=bool)
+    has_boundary[label[boundary]] = True
+    if not has_boundary.all():
+        c = int(np.argmin(has_boundary))
+        v = int(np.argmax(label == c))
+        raise NonUniqueSolutionError(
+            f"the component containing vertex {v} has no boundary vertex: the Dirichlet problem's "
+            "solution is not unique there (any constant can be added, Cor 6.3); add a boundary vertex to it"
+        )
+
+
+def dirichlet_solve(L: sp.spmatrix, boundary, values) -> np.ndarray:
+    """The solution of the discrete Dirichlet boundary value problem (dDBVP, Cor 6.4, Thm 6.5):
+
+        (L f)_i = 0 for i ∉ V₀,   f_i = c_i for i ∈ V₀,
+
+    by one sparse LU factorisation of the interior block, `L_II f_I = −L_IB c`.
+
+    **Arguments:** `L` (nv, nv) sparse (any Laplacian: a graph's, the cotan Laplacian of a mesh,
+    the Laplace–Beltrami operator); `boundary` V₀ (indices, or a bool mask); `values` c, (nb,) or
+    (nb, k) for k right-hand sides (e.g. the coordinates of a surface, Fig 6.5), ordered like
+    `boundary` (like its True entries for a mask).
+    **Returns:** f, (nv,) or (nv, k).
+    **Raises:** `InvalidInputError` for a boundary index that does not exist, `NonFiniteError`
+    for NaN values, `NonUniqueSolutionError` when a component has no boundary vertex or the
+    interior block is singular (possible with negative weights).
+    """
+    L = sp.csr_matrix(L)
+    n = L.shape[0]
+    b = boundary_indices(boundary, n)
+    c = np.array(values, dtype=np.float64)
+    if c.shape[:1] != (b.size,) or c.ndim > 2:
+        raise ShapeError(f"values must have shape ({b.size},) or ({b.size}, k), one row per boundary vertex, got {c.shape}")
+    check_finite(c, "values")
+    check_unique(L, b)
+    interior = np.ones(n, dtype=bool)
+    interior[b] = False
+    inner = np.flatnonzero(interior)
+    f = np.zeros((n,) + c.shape[1:])
+    f[b] = c
+    if inner.size == 0:
+        return f
+    rows = L[inner]
+    try:
+        lu = splu(rows[:, inner].tocsc(), permc_spec="MMD_AT_PLUS_A")
+    except RuntimeError as err:
+        raise NonUniqueSolutionError(
+            f"the interior block of the Laplacian is singular ({err}): the Dirichlet problem has no unique "
+            "solution (possible with negative weights, eq 6.3)"
+        ) from None
+    f[inner] = lu.solve(-(rows[:, b] @ c))
+    return f
+
+
 def graph_sparse(edges, weights, boundary, values, *, n_vertices: int | None = None) -> np.ndarray:
     """The solution f (nv,) of the problem `graph(...)` by one sparse LU solve (same arguments,
     same errors): the fast path for large graphs."""
     L = dg.laplace.graph_laplacian(edges, weights, n_vertices)
     b, c, _ = _boundary_data(L.shape[0], boundary, values)
-    return dg.laplace.dirichlet_solve(L, b, c)
+    return dirichlet_solve(L, b, c)
 
 
 def cotan_sparse(V, F, boundary, values) -> np.ndarray:
@@ -125,4 +186,4 @@ def cotan_sparse(V, F, boundary, values) -> np.ndarray:
     V, F = checked_triangle_mesh(V, F, manifold=True)
     L = dg.laplace.cotan_laplacian(V, F)
     b, c, _ = _boundary_data(V.shape[0], boundary, values)
-    return dg.laplace.dirichlet_solve(L, b, c)
+    return dirichlet_solve(L, b, c)

@@ -17,9 +17,10 @@ then the integral over edge k of the pointwise Euler–Lagrange residual `−T''
 weak residual), so `tol` bounds the same quantity at every n.  (Dividing further by h, to the
 pointwise residual, would put its float64 round-off floor, ~ε/h², above 1e-10 from n ≈ 10³.)
 
-**Constraints.**  |T_k|² − 1 = 0 for every free edge, and the chord `c − h Σ_k T_k = 0`
-(Remark 3.7: factorising translations, the end points become the chord).  Constraint order:
-the unit constraints of the free edges in edge order, then the three chord components.
+**Constraints** (named).  `"unit"`: |T_k|² − 1 = 0 for every free edge, in edge order;
+`"chord"`: `c − h Σ_k T_k = 0` (3,) (Remark 3.7: factorising translations, the end points
+become the chord).  `solve(...).multipliers` is the dict `{"chord": (3,), "unit": (m,)}`; the
+flat constraint vector is the chord, then the unit constraints (sorted names).
 
 **Clamps.**  `clamp="edge"` is Def 3.2: T_0 and T_{n−1} are fixed.  It prescribes the tangent of
 the first *edge*, i.e. of the smooth curve at s = h/2, so the discrete curve is only O(h) close
@@ -61,6 +62,7 @@ __all__ = [
     "pendulum_gravity",
     "edge_length",
     "curve",
+    "unit_and_chord",
     "InfeasibleChordError",
 ]
 
@@ -114,6 +116,15 @@ def _unit(T1, _):
 
 def _chord(T1, share, p):
     return share * p["chord"] - p["h"] * T1[0]
+
+
+def unit_and_chord(free_edges: np.ndarray, n: int, unit=_unit, chord=_chord) -> dg.locality.Local:
+    """The named constraints `{"unit": |T_k|² − 1 (k in free_edges), "chord": c − h Σ_k T_k}`
+    (module docstring), with the densities `unit`, `chord` (the rod passes its own)."""
+    return dg.concat(
+        unit=dg.local_map(unit, free_edges[:, None]),
+        chord=dg.local_sum(chord, np.arange(n)[:, None], data=np.full(n, 1.0 / n)),
+    )
 
 
 def edge_length(problem: dg.Problem) -> float:
@@ -204,6 +215,10 @@ def clamped(
     clamped (`clamp="edge"`: T_0 = t_start, T_{n−1} = t_end; `clamp="vertex"`: the end vertex
     tangents, see the module docstring).  The curve is `curve(T, problem)`.
 
+    Constraints `{"unit": (m,), "chord": (3,)}`: `"unit"` has one entry per free edge, m = n − 2
+    with `clamp="edge"` (the unit multiplier of a clamped edge is undetermined: T_0 and
+    T_{n−1} are fixed, so it has no equation) and m = n with `clamp="vertex"`.
+
     **Raises:** `InfeasibleChordError` if |chord| ≥ length (only the straight segment, or
     nothing, is left); `InvalidInputError`/`ShapeError` for bad n, clamps or vectors;
     `NonFiniteError` for NaN in `x0`.
@@ -225,10 +240,7 @@ def clamped(
     else:
         energy = energy + dg.local_sum(_ghost_bend, np.array([[0], [n - 1]]), data=np.array([0, 1]))
         free_edges = edges
-    constraints = dg.concat(
-        dg.local_map(_unit, free_edges[:, None]),
-        dg.local_sum(_chord, edges[:, None], data=np.full(n, 1.0 / n)),
-    )
+    constraints = unit_and_chord(free_edges, n)
     params = {"h": h, "chord": jnp.asarray(chord), "t_start": jnp.asarray(t_start), "t_end": jnp.asarray(t_end)}
     return dg.Problem(
         energy, T0, constraints=constraints, params=params, fixed=fixed,
@@ -244,10 +256,7 @@ def closed(n: int, *, length: float = 1.0, x0) -> dg.Problem:
     T0 = starting_array(x0, lambda: None, (n, 3))
     edges = np.arange(n)
     energy = dg.local_sum(_bend, np.stack([np.roll(edges, 1), edges], axis=1))
-    constraints = dg.concat(
-        dg.local_map(_unit, edges[:, None]),
-        dg.local_sum(_chord, edges[:, None], data=np.full(n, 1.0 / n)),
-    )
+    constraints = unit_and_chord(edges, n)
     params = {"h": h, "chord": jnp.zeros(3), "t_start": jnp.zeros(3), "t_end": jnp.zeros(3)}
     return dg.Problem(
         energy, T0, constraints=constraints, params=params,
@@ -267,8 +276,9 @@ def resample(T: Float[Array, "n 3"], n: int) -> Float[Array, "m 3"]:
 
 
 def load(solution) -> Float[Array, "3"]:
-    """The chord multipliers λ: they converge to the smooth load a of `T'' = cT + a` (Thm 3.2)."""
-    return solution.multipliers[-3:]
+    """The chord multipliers λ = `multipliers["chord"]` (3,): they converge to the smooth load a
+    of `T'' = cT + a` (Thm 3.2)."""
+    return solution.multipliers["chord"]
 
 
 def theorem_3_8_a(solution, problem: dg.Problem) -> Float[Array, "3"]:

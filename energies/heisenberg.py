@@ -67,20 +67,15 @@ def check_spins(S, tol: float = 1e-10) -> None:
         raise NonUnitSpinError(f"spin {i} has length {np.linalg.norm(arr[i]):.15g}, not 1 (spins live on S²)")
 
 
-def hamiltonian(kind: str, J: float = 1.0, *, closed: bool = True) -> Callable:
-    """`H(S)` of the naive or integrable closed chain with coupling J ≠ 0.
+def hamiltonian(kind: str, J: float = 1.0) -> Callable:
+    """`H(S)` of the naive or integrable closed chain (periodic, S_{N+1} = S_1, Sec A) with
+    coupling J ≠ 0.
 
-    **Raises:** `InvalidInputError` for an unknown kind, J = 0 or non-finite, or an open chain
-    (`closed=False`: the chain of Sec A is periodic, N + 1 = 1); when called on concrete spins,
+    **Raises:** `InvalidInputError` for an unknown kind, J = 0 or non-finite; when called on concrete spins,
     `NonUnitSpinError` / `NonFiniteError` / `ShapeError` naming the spin.
     """
     if kind not in KINDS:
         raise InvalidInputError(f"kind must be one of {KINDS}, got {kind!r}")
-    if not closed:
-        raise InvalidInputError(
-            "the Heisenberg chain of Sec A is closed (periodic boundary conditions, S_{N+1} = S_1); "
-            "an open chain has no Hamiltonian here"
-        )
     if not (np.isfinite(J) and J != 0):
         raise InvalidInputError(f"the coupling J must be finite and non-zero (J = 0 is no interaction), got {J}")
     energy = naive_energy if kind == "naive" else integrable_energy
@@ -89,7 +84,6 @@ def hamiltonian(kind: str, J: float = 1.0, *, closed: bool = True) -> Callable:
         check_spins(S)
         return energy(S, J)
 
-    H.kind, H.J = kind, J
     return H
 
 

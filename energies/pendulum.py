@@ -58,8 +58,8 @@ def _unit_vector(v, name: str) -> np.ndarray:
 def action(n: int, *, a, T_first, T_last, x0=None) -> dg.Problem:
     """The action S of Def 3.3 over n tangents with T_0 = T_first and T_{n−1} = T_last fixed.
 
-    Unknowns: `T` (n, 3); constraints |T_k|² = 1 for the free k.  The default start is the
-    great-circle interpolation of the end tangents.
+    Unknowns: `T` (n, 3); constraints `{"unit": |T_k|² − 1 for the free k}` (n − 2,).  The
+    default start is the great-circle interpolation of the end tangents.
     """
     if int(n) < 3:
         raise InvalidInputError(f"the pendulum needs at least 3 tangents, got n = {n}")
@@ -69,7 +69,7 @@ def action(n: int, *, a, T_first, T_last, x0=None) -> dg.Problem:
     k = np.arange(n)
     energy = dg.local_sum(_kinetic_term, np.stack([k[:-1], k[1:]], axis=1)) + dg.local_sum(_potential_term, k[:, None])
     return dg.Problem(
-        energy, T0, constraints=dg.local_map(_unit, k[1:-1, None]), params={"a": jnp.asarray(a, dtype=float)},
+        energy, T0, constraints=dg.concat(unit=dg.local_map(_unit, k[1:-1, None])), params={"a": jnp.asarray(a, dtype=float)},
         fixed=fixed, name=f"discrete spherical pendulum (n={n})",
     )
 
@@ -83,13 +83,14 @@ def _tangent_basis(T):
 
 
 def _lagrangian_map_equations(T_next, p):
-    """|T_{k+1}|² − 1 and the tangential part of ∇_{T_k} S (Def 3.3), by autodiff."""
+    """`{"unit": |T_{k+1}|² − 1, "stationary": the tangential part (2,) of ∇_{T_k} S}` (Def 3.3),
+    by autodiff."""
     def S_k(T_curr):
         return kinetic(p["T_prev"], T_curr) + kinetic(T_curr, T_next) - jnp.dot(p["a"], T_curr)
 
     force = jax.grad(S_k)(p["T_curr"])
     e1, e2 = _tangent_basis(p["T_curr"])
-    return jnp.array([jnp.dot(T_next, T_next) - 1.0, jnp.dot(force, e1), jnp.dot(force, e2)])
+    return {"unit": jnp.dot(T_next, T_next) - 1.0, "stationary": jnp.stack([jnp.dot(force, e1), jnp.dot(force, e2)])}
 
 
 def _no_energy(T_next, p):

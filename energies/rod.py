@@ -8,8 +8,8 @@ Unknowns: one unit quaternion Φ_k per edge (n, 4); the edge tangent is `T_k = �
 
 the discrete elastica's bending term (`elastica.bending_density`, → ½∫κ²) plus α times the
 squared discrete twist angles θ_k of `Φ_k Φ_{k−1}⁻¹ = t_k b_k` (`frames.twist_angle`, θ_k/h → τ),
-so that the smooth limit is ½∫(κ² + ατ²) ds.  Constraints: |Φ_k|² = 1 for the free frames and
-the chord `c − h Σ T_k = 0`.
+so that the smooth limit is ½∫(κ² + ατ²) ds.  Constraints (named, as for the elastica):
+`"unit"`, |Φ_k|² − 1 = 0 for the free frames, and `"chord"`, `c − h Σ T_k = 0` (3,).
 
 **Clamps** (as for `elastica.clamped`).  `clamp="edge"`: the end frames Φ_0, Φ_{n−1} are fixed.
 They are the frames of the first and last *edge*, i.e. of the smooth rod at s = h/2 and
@@ -40,7 +40,7 @@ from ddgjax import frames
 from ddgjax import quaternion as qt
 from ddgjax.errors import InvalidInputError
 
-from .elastica import bending_density, checked_chord, clamp_ends, starting_array
+from .elastica import bending_density, checked_chord, clamp_ends, starting_array, unit_and_chord
 
 __all__ = ["clamped", "tangents", "twist_angles", "curve", "load", "ClampMismatchError"]
 
@@ -59,7 +59,7 @@ def _vertex_energy(Phi2, p):
 
 def _reflected(Phi, q):
     """The reflection `q Φ⁻¹ q` of a unit quaternion Φ in q (q exp(v) ↦ q exp(−v))."""
-    return qt._mul(qt._mul(q, qt._conj(Phi)), q)
+    return qt.mul(qt.mul(q, qt.conj(Phi)), q)
 
 
 def _ghost_vertex_energy(Phi1, which, p):
@@ -119,7 +119,8 @@ def clamped(
     `frame_start`, `frame_end`: unit quaternions [4], the clamped frames (their tangents are
     `rotate(frame, e1)`), of the end edges (`clamp="edge"`) or the end vertices
     (`clamp="vertex"`, second order; module docstring).  `t_start`, `t_end` (optional): the end
-    tangents, checked against the frames.
+    tangents, checked against the frames.  Constraints `{"unit": (m,), "chord": (3,)}` with
+    one unit entry per free frame (m = n − 2 for `clamp="edge"`, n for `"vertex"`).
 
     **Raises:** `InfeasibleChordError` (|chord| ≥ length), `InvalidInputError` (α ≤ 0, n < 3,
     non-unit frames, unknown clamp), `ClampMismatchError` (a frame's tangent is not the given
@@ -150,10 +151,7 @@ def clamped(
     else:
         energy = energy + dg.local_sum(_ghost_vertex_energy, np.array([[0], [n - 1]]), data=np.array([0, 1]))
         fixed, free_edges = np.zeros((n, 4), bool), edges
-    constraints = dg.concat(
-        dg.local_map(_unit, free_edges[:, None]),
-        dg.local_sum(_chord, edges[:, None], data=np.full(n, 1.0 / n)),
-    )
+    constraints = unit_and_chord(free_edges, n, _unit, _chord)
     params = {
         "h": h, "alpha": jnp.asarray(float(alpha)), "chord": jnp.asarray(chord),
         "frame_start": jnp.asarray(q0), "frame_end": jnp.asarray(q1),
@@ -179,5 +177,6 @@ def curve(Phi, problem: dg.Problem, start=(0.0, 0.0, 0.0)) -> jnp.ndarray:
 
 
 def load(solution) -> jnp.ndarray:
-    """The chord multipliers λ (3,): the load `a` of Thm 3.13 (i) (module docstring)."""
-    return jnp.asarray(solution.multipliers[-3:])
+    """The chord multipliers λ = `multipliers["chord"]` (3,): the load `a` of Thm 3.13 (i)
+    (module docstring)."""
+    return jnp.asarray(solution.multipliers["chord"])

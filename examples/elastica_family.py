@@ -10,7 +10,7 @@ import numpy as np
 from _common import output_dir, run
 
 import ddgjax as dg
-from ddgjax import elastica_exact as exact
+from ddgjax.smooth import elastica as exact
 from energies import elastica
 from solvers import solve
 

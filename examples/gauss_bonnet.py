@@ -23,7 +23,7 @@ def main(out=None, tiny: bool = False):
         total = float(np.sum(np.asarray(mesh.angle_defect(V, F))))
         print(f"{name:17s} χ = {mesh.euler_characteristic(F):2d}   Σ K / 2π = {total / (2 * np.pi):+.12f}   {mesh.classify(F)}")
     drawn = ("torus",) if tiny else ("torus", "double_torus")
-    return [dg.plot_surface.surface(*getattr(mesh, name)(), path=out / f"gauss_bonnet_{name}.png", title=f"angle defect, {name}")
+    return [dg.plot.surface.surface(*getattr(mesh, name)(), path=out / f"gauss_bonnet_{name}.png", title=f"angle defect, {name}")
             for name in drawn]
 
 

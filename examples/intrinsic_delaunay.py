@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from _common import output_dir, run
 
+import ddgjax as dg
 from ddgjax import intrinsic, mesh
 from ddgjax.plot import save_figure
 
@@ -67,7 +68,7 @@ def ellipsoid(level: int, path):
 def main(out=None, tiny: bool = False):
     out = output_dir(out)
     V, F, _ = mesh.builtin.tall_dome(0, n_inner=60 if tiny else 300, height=0.0)  # a flat disk with skinny triangles
-    result = intrinsic.plot.before_after(V, F, out / "intrinsic_delaunay_disk.png")
+    result = dg.plot.intrinsic.before_after(V, F, out / "intrinsic_delaunay_disk.png")
     print(f"flat disk: {result.n_flips} flips to the planar Delaunay triangulation")
     return [ellipsoid(2 if tiny else 3, out / "intrinsic_delaunay_ellipsoid.png"), out / "intrinsic_delaunay_disk.png"]
 

@@ -14,12 +14,13 @@ import numpy as np
 from _common import output_dir, run
 
 from ddgjax import intrinsic
+from ddgjax.verify import figures
 
 
 def main(out=None, tiny: bool = False):
     out = output_dir(out)
     m = 16 if tiny else 32
-    V, F, _, cotan, narrow = intrinsic.minimal.fig_7_26(0, budget=30, n_inner=50 if tiny else 150, m=m)
+    V, F, _, cotan, narrow = figures.fig_7_26(0, budget=30, n_inner=50 if tiny else 150, m=m)
     for name, (_, _, info) in (("Fig 6.5  (cotan Laplacian)", cotan), ("Fig 7.23 (Delaunay flips)", narrow)):
         state = "converged" if info["converged"] else "out of budget" if info["iterations"] == 30 else "broke down"
         print(f"{name}: {state:13s} after {info['iterations']:2d} steps, residual {info['residual']:.2e}, "
@@ -28,7 +29,7 @@ def main(out=None, tiny: bool = False):
     tri = narrow[2]["triangulation"]
     print(f"the flat {m}-gon has area {polygon:.10f}; the result is Delaunay: {intrinsic.is_delaunay(tri)}, "
           f"min Laplace–Beltrami weight {intrinsic.cotan_weights(tri).min():+.2e}")
-    return intrinsic.plot.draw_fig_7_26(out / "narrow_minimal_surface.png", V, F, cotan, narrow)
+    return figures.draw_fig_7_26(out / "narrow_minimal_surface.png", V, F, cotan, narrow)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ import jax.numpy as jnp
 
 from ddgjax._flat import Layout, layout_of
 from ddgjax.locality import Local
+from ddgjax.problem import ConstraintStructure
 
 
 def _function_key(fn):
@@ -35,13 +36,13 @@ class Spec:
     energy: Callable
     constraints: Callable | None
     layout: Layout
-    n_constraints: int
+    constraint_structure: ConstraintStructure
     is_local: bool
     has_scale: bool
 
     def key(self):
         cons = None if self.constraints is None else _function_key(self.constraints)
-        return (_function_key(self.energy), cons, self.layout, self.n_constraints, self.is_local, self.has_scale)
+        return (_function_key(self.energy), cons, self.layout, self.constraint_structure, self.is_local, self.has_scale)
 
     def __hash__(self):
         return hash(self.key())
@@ -55,7 +56,7 @@ class Spec:
 
     @property
     def m(self) -> int:
-        return self.n_constraints
+        return self.constraint_structure.size
 
 
 def spec_of(problem) -> Spec:
@@ -63,7 +64,7 @@ def spec_of(problem) -> Spec:
         problem.energy,
         problem.constraints,
         layout_of(problem),
-        problem.n_constraints,
+        problem.constraint_structure,
         problem.is_local,
         problem.residual_scale is not None,
     )
@@ -86,7 +87,7 @@ class KKT:
     def g(self, u):
         if self.spec.constraints is None:
             return jnp.zeros((0,), dtype=u.dtype)
-        return jnp.ravel(self.spec.constraints(self.x(u), self.params))
+        return self.spec.constraint_structure.ravel(self.spec.constraints(self.x(u), self.params))
 
     def split(self, w):
         return w[: self.spec.n], w[self.spec.n :]

@@ -56,6 +56,7 @@ from jax.scipy.sparse.linalg import cg, gmres
 
 from . import _banded as banded
 from ._banded import Chain, chain_arrays, chain_structure
+from ._cache import derived
 from ._kkt import KKT
 from ._linear import _Algebra, _regularisation
 from ._sparse import PatternKey, SparsePattern, index_arrays, kkt_values
@@ -223,10 +224,11 @@ class KrylovAlgebra(_Algebra):
         """The back end for a problem: with the block-tridiagonal preconditioner if it is a chain."""
         if pattern is None:
             return cls()
-        if "_chain" not in pattern.__dict__:  # made once per pattern: jit's cache compares it by identity
-            shape = spec.layout.shapes[0]
-            pattern.__dict__["_chain"] = chain_structure(pattern, spec.layout.free, shape[1] if len(shape) == 2 else 1)
-        return cls(pattern, chain=pattern.__dict__["_chain"])
+        shape = spec.layout.shapes[0]
+        width = shape[1] if len(shape) == 2 else 1
+        # made once per pattern: jit's cache compares it by identity
+        chain = derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width))
+        return cls(pattern, chain=chain)
 
     def tree_flatten(self):
         names = () if self.index is None else tuple(sorted(self.index))
@@ -240,7 +242,7 @@ class KrylovAlgebra(_Algebra):
         key, rtol, maxiter, names, has_chain = aux
         if key is None:
             return cls(None, rtol, maxiter)
-        return cls(key.pattern, rtol, maxiter, dict(zip(names, children)), key.pattern.__dict__["_chain"] if has_chain else None)
+        return cls(key.pattern, rtol, maxiter, dict(zip(names, children)), derived(key.pattern, "chain") if has_chain else None)
 
     def matrix(self, kkt: KKT, w, identity_hessian=False) -> Linearisation:
         if self.pattern is not None:

@@ -10,7 +10,7 @@ import jax.numpy as jnp
 
 from ddgjax._checks import is_concrete
 from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError
-from ddgjax.problem import Problem, validate_multipliers
+from ddgjax.problem import Problem, flatten_multipliers
 
 from ._first_order import augmented_lagrangian
 from ._implicit import implicit_solution
@@ -28,7 +28,8 @@ class Solution(NamedTuple):
     """The result of `solve`.
 
     - `x`: the critical point, a pytree like `x0` (fixed entries bit-for-bit from `x0`).
-    - `multipliers`: 1-D, ordered like the constraint vector; `∇E(x) = Jg(x)ᵀ multipliers`.
+    - `multipliers`: `∇E(x) = Jg(x)ᵀ multipliers`; 1-D, ordered like the constraint vector, or
+      for named constraints a pytree like the constraints' output (`multipliers["chord"]`).
     - `energy`: `E(x)`.
     - `residual`: max-norm of the (scaled) KKT residual at `x`.
     - `steps`: Newton steps taken (outer augmented-Lagrangian steps for `method="lbfgs"`).
@@ -38,7 +39,7 @@ class Solution(NamedTuple):
     """
 
     x: object
-    multipliers: jax.Array
+    multipliers: object
     energy: jax.Array
     residual: jax.Array
     steps: jax.Array
@@ -111,7 +112,7 @@ def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, firs
     u, lam = kkt_diff.split(w)
     x = kkt_diff.x(u)
     energy = kkt_diff.energy(u)
-    return Solution(x, lam, energy, residual, steps, residual <= tol, history, status)
+    return Solution(x, spec.constraint_structure.unravel(lam), energy, residual, steps, residual <= tol, history, status)
 
 
 def solve(
@@ -143,7 +144,8 @@ def solve(
       CPU, else dense up to N = n + m = 2,000 unknowns and multipliers, else Krylov).
     - `throw`: raise `ConvergenceError` when not converged (only outside `jit`/`vmap`; inside
       them check `Solution.converged`).
-    - `multipliers0`: starting multipliers (default: least squares `argmin |∇E − Jᵀλ|` at x0).
+    - `multipliers0`: starting multipliers, flat or named like `Solution.multipliers` (default:
+      least squares `argmin |∇E − Jᵀλ|` at x0).
     - `warm_start="lbfgs"`: run up to 50 augmented-Lagrangian L-BFGS steps before Newton, for
       minimisation problems started far away.
 
@@ -153,7 +155,8 @@ def solve(
     the sparse path; `solve_batch` packages it and shards a batch over devices).
 
     **Raises:** `ConvergenceError` (with `.residual`, `.steps`, `.solution`), `NonFiniteError`
-    when the energy or residual is NaN at `x0`, `InvalidInputError` for unknown options.
+    when the energy or residual is NaN at `x0` (or in `multipliers0`), `ShapeError` for
+    `multipliers0` of the wrong shape or structure, `InvalidInputError` for unknown options.
     """
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
@@ -163,13 +166,13 @@ def solve(
         raise InvalidInputError(f"tol must be positive, got {tol}")
     if int(max_steps) < 0:
         raise InvalidInputError(f"max_steps must be >= 0, got {max_steps}")
-    validate_multipliers(problem, multipliers0)
+    lam0 = None if multipliers0 is None else flatten_multipliers(problem, multipliers0)
     spec = spec_of(problem)
     if spec.n == 0:
         raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
     algebra = _choose_algebra(problem, spec, "dense" if method == "lbfgs" else method)
     z0 = spec.layout.ravel(problem.x0)
-    lam0 = None if multipliers0 is None else jnp.asarray(multipliers0, dtype=z0.dtype)
+    lam0 = None if lam0 is None else lam0.astype(z0.dtype)
     first_order = FIRST_ORDER_OUTER if warm_start == "lbfgs" else (int(max_steps) if method == "lbfgs" else 0)
     try:
         sol = _solve_jit(

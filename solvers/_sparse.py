@@ -19,6 +19,7 @@ import numpy as np
 from ddgjax.errors import InvalidInputError
 from ddgjax.locality import Local, Term
 
+from ._cache import LRU, derived
 from ._kkt import KKT, Spec
 
 
@@ -59,21 +60,17 @@ class SparsePattern:
         """The KKT matrix split at the coupled multipliers; None if there are none."""
         if not self.coupled.size:
             return None
-        if "_split" not in self.__dict__:
-            self.__dict__["_split"] = bordered(self.rows, self.cols, self.coupled, self.n + self.m)
-            self.__dict__["_split"].symbolic()
-        return self.__dict__["_split"]
+        return derived(self, "split", lambda: bordered(self.rows, self.cols, self.coupled, self.n + self.m))
 
     def symbolic(self):
         """KLU's symbolic analysis (ordering) of the KKT matrix, made once and kept here.
 
-        Made outside any trace and kept alive by this pattern, which `jit`'s cache holds
-        through the static `SparseAlgebra`; every factorisation then skips the ordering.  The
-        analysis depends on the pattern only, so the complex Levenberg–Marquardt solves reuse it.
+        Made outside any trace and kept as long as this pattern lives (`_cache.derived`), which
+        `jit`'s cache holds through the static `SparseAlgebra`; every factorisation then skips the
+        ordering.  The analysis depends on the pattern only, so the complex Levenberg–Marquardt
+        solves reuse it.
         """
-        if "_symbolic" not in self.__dict__:
-            self.__dict__["_symbolic"] = _analyze(self.rows, self.cols, self.n + self.m)
-        return self.__dict__["_symbolic"]
+        return derived(self, "symbolic", lambda: _analyze(self.rows, self.cols, self.n + self.m))
 
     def blocks(self) -> tuple[np.ndarray, np.ndarray]:
         """Value indices `(H entries, −J entries)` of the coalesced KKT matrix."""
@@ -86,8 +83,7 @@ class Bordered:
     """A sparse matrix `[[A, B], [Bᵗ, C]]` split at a few coupled indices (the border).
 
     A constraint that sums over all cells (a chord, a closure) fills a whole row and column of
-    the KKT matrix; LU with pivoting turns such rows into catastrophic fill (0.2 s instead of
-    5 ms for n = 2,000 elastica edges).  Eliminating the border by its Schur complement keeps
+    the KKT matrix; LU with pivoting turns such rows into catastrophic fill.  Eliminating the border by its Schur complement keeps
     the factorised block `A` banded:  `A Y = [b_A, B]`,  `S = C − Bᵗ Y_B`,
     `x_C = S⁻¹ (b_C − Bᵗ y_b)`,  `x_A = y_b − Y_B x_C` — one KLU factorisation with
     1 + (border size) right-hand sides, and a tiny dense solve.
@@ -113,10 +109,8 @@ class Bordered:
     take_c: np.ndarray
 
     def symbolic(self):
-        """KLU's analysis of A, made once (outside any trace) and kept here."""
-        if "_symbolic" not in self.__dict__:
-            self.__dict__["_symbolic"] = _analyze(self.a_rows, self.a_cols, len(self.interior))
-        return self.__dict__["_symbolic"]
+        """KLU's analysis of A, made once (outside any trace) and kept while this split lives."""
+        return derived(self, "symbolic", lambda: _analyze(self.a_rows, self.a_cols, len(self.interior)))
 
 
 def bordered(rows: np.ndarray, cols: np.ndarray, border: np.ndarray, size: int) -> Bordered:
@@ -226,14 +220,13 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
     )
 
 
+PATTERNS = LRU(8)
+"""Sparsity patterns by declaration (`Spec.key()`): the few most recent, since they can be large."""
+
+
 def cached_pattern(spec: Spec, x0, params) -> SparsePattern:
-    """`build_pattern`, memoised on the energy declaration (no module-level cache)."""
-    store = spec.energy.__dict__.setdefault("_patterns", {})
-    key = (spec.key(),)
-    if key not in store:
-        store.clear()  # keep one pattern per declaration: they can be large
-        store[key] = build_pattern(spec, x0, params)
-    return store[key]
+    """`build_pattern`, memoised on the problem's declaration in the bounded `PATTERNS`."""
+    return PATTERNS.get(spec.key(), lambda: build_pattern(spec, x0, params))
 
 
 def _cell_hessians(term: Term, x, params, weights=None):
@@ -284,23 +277,24 @@ SPLIT_ARRAYS = ("interior", "border", "a_rows", "a_cols", "take_a", "b_rows", "b
 
 
 def index_arrays(pattern: SparsePattern) -> dict:
-    """The pattern's index arrays as int32 device arrays, made once and kept on the pattern.
+    """The pattern's index arrays as int32 device arrays, made once per pattern (`_cache.derived`).
 
     The solvers take them as *arguments* of the compiled solver, not as constants compiled into
-    it: at 10⁵ elastica edges constants of this size (~200 MB) made XLA's compile take 1.3 GB
-    more memory, held for the executable's lifetime; gathers with traced indices are as fast
-    (7.8·10⁶-entry gather + segment sum: 0.11 s either way).
+    it: large constants inflate XLA's compile memory for the executable's lifetime, and gathers
+    with traced indices are as fast.
     """
-    if "_index" not in pattern.__dict__:
-        h_at, j_at = pattern.blocks()
-        arrays = {"source": pattern.source, "target": pattern.target, "rows": pattern.rows, "cols": pattern.cols,
-                  "diagonal": pattern.target[pattern.source.shape[0]:], "h_at": h_at, "j_at": j_at}
-        split = pattern.split()
-        if split is not None:
-            arrays.update({f"split_{name}": getattr(split, name) for name in SPLIT_ARRAYS})
-        with jax.ensure_compile_time_eval():  # concrete arrays even when first made under a trace (shard_map)
-            pattern.__dict__["_index"] = {k: jnp.asarray(np.asarray(v, dtype=np.int32)) for k, v in arrays.items()}
-    return pattern.__dict__["_index"]
+    return derived(pattern, "index", lambda: _device_index_arrays(pattern))
+
+
+def _device_index_arrays(pattern: SparsePattern) -> dict:
+    h_at, j_at = pattern.blocks()
+    arrays = {"source": pattern.source, "target": pattern.target, "rows": pattern.rows, "cols": pattern.cols,
+              "diagonal": pattern.target[pattern.source.shape[0]:], "h_at": h_at, "j_at": j_at}
+    split = pattern.split()
+    if split is not None:
+        arrays.update({f"split_{name}": getattr(split, name) for name in SPLIT_ARRAYS})
+    with jax.ensure_compile_time_eval():  # concrete arrays even when first made under a trace (shard_map)
+        return {k: jnp.asarray(np.asarray(v, dtype=np.int32)) for k, v in arrays.items()}
 
 
 class PatternKey:

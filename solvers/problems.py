@@ -56,7 +56,8 @@ def unit_chain(n: int, *, field=(1.0, -0.5, 2.0), chord=None, local=True, seed=0
     ∫|X'|²/2 + <f, X>, so the answer has a smooth limit and Newton's step count does not grow),  |X_k|² = 1 for the free k, and optionally
     Σ_k X_k = chord.  X_0 = e1 and X_{n-1} = (cos turn, sin turn, 0) are fixed; the start is
     the normalised linear interpolation plus noise.  Declared local (dg.local_sum /
-    dg.local_map) or as plain functions.
+    dg.local_map) or as plain functions.  Constraints: `|X_k|² − 1` (n − 2,) alone, or with a
+    chord the named `{"unit": (n − 2,), "chord": (3,)}`.
     """
     rng = np.random.default_rng(seed)
     s = np.linspace(0.0, 1.0, n)[:, None]
@@ -86,13 +87,13 @@ def unit_chain(n: int, *, field=(1.0, -0.5, 2.0), chord=None, local=True, seed=0
         energy = dg.local_sum(bond, edges) + dg.local_sum(potential, np.arange(n)[:, None])
         cons = dg.local_map(unit, interior[:, None])
         if chord is not None:
-            cons = dg.concat(cons, dg.local_sum(chord_term, np.arange(n)[:, None]))
+            cons = dg.concat(unit=cons, chord=dg.local_sum(chord_term, np.arange(n)[:, None]))
     else:
         def energy(X, _):
             return n * jnp.sum(1.0 - jnp.sum(X[:-1] * X[1:], axis=1)) + jnp.sum(X @ f) / n
 
         def cons(X, c):
             unit_part = jnp.sum(X[1:-1] ** 2, axis=1) - 1.0
-            return unit_part if chord is None else jnp.concatenate([unit_part, X.sum(0) - c])
+            return unit_part if chord is None else {"unit": unit_part, "chord": X.sum(0) - c}
 
     return dg.Problem(energy, X0, constraints=cons, params=None if chord is None else jnp.asarray(chord), fixed=fixed)

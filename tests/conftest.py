@@ -22,6 +22,18 @@ def tree_max_abs_diff(a, b) -> float:
     return max(jax.tree_util.tree_leaves(diffs))
 
 
+@pytest.fixture(autouse=True, scope="module")
+def _release_compiled_programs():
+    """Drop JAX's compiled programs after each test module.
+
+    Every XLA CPU executable keeps its own memory mappings; a few thousand of them, held by the
+    jit caches over the whole suite, reach the kernel's limit on mappings per process
+    (vm.max_map_count, 65530), and the next compilation aborts the process.  Programs are rarely
+    shared between modules, so releasing them costs little."""
+    yield
+    jax.clear_caches()
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(1234)

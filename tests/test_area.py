@@ -1,7 +1,5 @@
 """Simplicial area and minimal surfaces (Sec 6.4, Thm 6.7, Fig 6.5, Fig 6.6 / eq 6.3)."""
 
-import importlib.util
-
 import jax
 import numpy as np
 import pytest
@@ -14,6 +12,7 @@ from ddgjax.errors import (
     NonFiniteError,
     NonManifoldError,
 )
+from ddgjax.verify import references
 from energies import area, dirichlet
 
 
@@ -52,18 +51,12 @@ def cylinder(n, R=1.0, H=0.5):
     return np.stack([R * np.cos(t), R * np.sin(t), H * (2 * s - 1)], 1), F
 
 
-def catenoid_neck(R=1.0, H=0.5):
-    """The larger root c of R = c cosh(H/c): the stable catenoid r(z) = c cosh(z/c)."""
-    c_fold = brentq(lambda c: np.tanh(H / c) - c / H, 1e-3 * H, H)  # where c cosh(H/c) is least
-    return brentq(lambda c: c * np.cosh(H / c) - R, c_fold, R)
-
-
 def neck_error(n):
     """|min_i r_i − c| after Fig 6.5 to an area-gradient residual 0.05 h⁴ (h ∝ 1/n: the
     gradient is O(h²) per vertex and the geometry must settle well below the O(h²) error)."""
     V, F = cylinder(n)
     V, F, _ = area.minimal_surface(V, F, tol=0.05 / n**4, max_iter=2000)
-    return abs(np.min(np.linalg.norm(V[:, :2], axis=1)) - catenoid_neck())
+    return abs(references.neck_radius(V) - references.catenoid_neck())
 
 
 @pytest.mark.parametrize("ns", [[6, 8, 12, 16], pytest.param([8, 16, 24, 32], marks=pytest.mark.slow)])
@@ -83,7 +76,7 @@ def test_newton_polishes_the_cotan_iterate():
     V2, _, info2 = area.minimal_surface(V1, F, method="newton", tol=1e-11)
     assert info2["converged"] and info2["iterations"] <= 5
     L = dg.laplace.cotan_laplacian(V2, F)
-    interior = np.setdiff1d(np.arange(len(V)), area.mesh_boundary(F, len(V)))
+    interior = np.setdiff1d(np.arange(len(V)), dg.mesh.boundary_vertices(F, len(V)))
     assert np.max(np.abs((L @ V2)[interior])) < 1e-11
     assert np.max(np.abs(V2 - V1)) < 1e-3
     assert info1["area"][-1] < info1["area"][0]
@@ -92,7 +85,7 @@ def test_newton_polishes_the_cotan_iterate():
 def test_planar_boundary_gives_a_planar_surface():
     V, F = dg.mesh.disk(4, 12)
     V = jittered(V, 2, 0.02)
-    b = area.mesh_boundary(F, len(V))
+    b = dg.mesh.boundary_vertices(F, len(V))
     V[b, 2] = 0.0
     before = V.copy()
     Vm, _, info = area.minimal_surface(V, F, tol=1e-12)
@@ -148,21 +141,15 @@ def test_bad_input():
         area.simplicial(np.random.default_rng(0).normal(size=(5, 3)), np.array([[0, 1, 2], [0, 3, 4]]))
 
 
-def test_delaunay_method_delegates_to_issue_7():
+def test_delaunay_method_is_the_harmonic_iteration_with_flips():
     V, F = cylinder(4)
-    if importlib.util.find_spec("ddgjax.intrinsic.minimal") is None:
-        with pytest.raises(NotImplementedError, match="issue 7"):
-            area.minimal_surface(V, F, method="delaunay")
-        return
-    from ddgjax.intrinsic.minimal import minimal_surface_delaunay
-
     V1, F1, info = area.minimal_surface(V, F, method="delaunay", tol=1e-6)
-    V2, F2, _ = minimal_surface_delaunay(V, F, None, tol=1e-6)
+    V2, F2, _ = area.harmonic_iteration(V, F, None, flip=True, tol=1e-6)
     assert info["converged"] and np.array_equal(V1, V2) and np.array_equal(F1, F2)
 
 
 def test_plot_minimal_surface(tmp_path):
-    from ddgjax import plot_laplace
+    from ddgjax.plot import laplace as plot_laplace
 
     V, F = cylinder(4)
     Vm, _, info = area.minimal_surface(V, F, tol=1e-5)

@@ -1,7 +1,7 @@
 """Flows on discrete arc-length curves (Section 2.2): the tangent flow (Prop 2.1) and the
 Heisenberg flow (Prop 2.2), derived by automatic differentiation of the local bending energy,
-checked against the closed forms, (2.5), (2.14), commutation, Remark 2.1's zig-zags and the
-smooth limits of Remark 2.3 and Remark 3.6."""
+checked against the closed forms, (2.5), (2.14), commutation and Remark 2.1's zig-zags.  The
+smooth limits of Remark 2.3 and Remark 3.6 are `ddgjax verify` checks (`sec2_flows`)."""
 
 import functools
 
@@ -13,9 +13,6 @@ import pytest
 import ddgjax as dg
 from ddgjax import curves
 from ddgjax.errors import ArcLengthError, NonFiniteError, ShapeError, SingularVertexError
-
-RESOLUTIONS = (16, 32, 64, 128, 256, 512)
-
 
 def closed_arc_length_curve(rng, n, noise=0.6):
     """A random closed regular curve with n unit edges: the tangents of a regular n-gon plus
@@ -36,12 +33,6 @@ def closed_arc_length_curve(rng, n, noise=0.6):
 def closed_curve(request):
     n, seed = request.param
     return jnp.asarray(closed_arc_length_curve(np.random.default_rng(seed), n))
-
-
-def space_curve(s):
-    """Closed arc-length curve of length 2π with unit tangent T = (cos s cos 2s, cos s sin 2s, sin s)
-    (latitude s, longitude 2s on S²): κ² = 1 + 4 cos² s, so ∫ κ² ds = 6π; non-planar."""
-    return jnp.array([(jnp.sin(s) + jnp.sin(3 * s) / 3) / 2, -(jnp.cos(s) + jnp.cos(3 * s) / 3) / 2, -jnp.cos(s)])
 
 
 # --- oracles: the closed forms of the reference (tests only) ---------------------------------
@@ -191,57 +182,6 @@ def test_remark_2_1_circular_zigzag_is_rotated():
     assert abs(omega[2]) > 0.1 and np.max(np.abs(omega[:2])) <= 1e-12
     generic = closed_arc_length_curve(np.random.default_rng(5), 12)
     assert rigid_motion_residual(generic, np.asarray(curves.tangent_flow(generic)))[0] > 1e-2
-
-
-# --- smooth limits --------------------------------------------------------------------------
-
-
-@functools.lru_cache(maxsize=None)
-def sampled_space_curve(n):
-    """n equal chords inscribed in the closed `space_curve`, their length ε, and T' × T there."""
-    gamma, s = curves.sample(space_curve, n, length=2 * np.pi, closed=True, equal_chords=True, return_parameters=True)
-    return gamma, float(np.mean(curves.edge_lengths(gamma, closed=True))), np.asarray(smooth_binormal(s))
-
-
-@jax.jit
-def smooth_binormal(s):
-    """T' × T at the parameters s (Remark 2.3, (2.12))."""
-    T = jax.vmap(jax.jacfwd(space_curve))(s)
-    return jnp.cross(jax.vmap(jax.jacfwd(jax.jacfwd(space_curve)))(s), T)
-
-
-@jax.jit
-def scaled_bending_energy(gamma, eps):
-    """(4/ε) Σ_k E_k over the vertices of a closed curve (Remark 3.6)."""
-    T = curves.tangents(gamma, closed=True)
-    return 4 / eps * jnp.sum(jax.vmap(curves.local_bending_energy)(jnp.roll(T, 1, axis=0), T))
-
-
-def assert_order(table, order, tol=0.1):
-    print("\n" + table.to_markdown())
-    assert abs(table.fitted_order - order) <= tol, table.to_markdown()
-    assert abs(table.orders[-1] - order) <= tol / 2, table.to_markdown()
-
-
-def test_remark_2_3_heisenberg_flow_with_time_scaled_by_eps_over_2_tends_to_T_prime_cross_T():
-    """w_k = T_k × T_{k−1} / (1 + <T_k, T_{k−1}>) = (ε/2) T' × T + O(ε³) with T_k = Δγ_k/ε:
-    after t → εt/2 the flow converges with order 2 (the O(ε²) terms cancel by symmetry)."""
-
-    def error(n):
-        gamma, eps, binormal = sampled_space_curve(n)
-        return np.max(np.abs(2 / eps * np.asarray(curves.heisenberg_flow(gamma)) - binormal))
-
-    assert_order(dg.limits.convergence(error, RESOLUTIONS, label="max |(2/ε) w_k − T' × T|"), 2.0)
-
-
-def test_remark_3_6_scaled_bending_energy_tends_to_integral_of_kappa_squared():
-    """E_k = log(1 + κ_k² ε²/4) with κ_k = 2 tan(φ_k/2)/ε, so (4/ε) Σ_k E_k → ∫ κ² ds = 6π."""
-
-    def error(n):
-        gamma, eps, _ = sampled_space_curve(n)
-        return abs(float(scaled_bending_energy(gamma, eps)) - 6 * np.pi)
-
-    assert_order(dg.limits.convergence(error, RESOLUTIONS, label="|(4/ε) Σ E_k − ∫κ²|"), 2.0)
 
 
 # --- jit, bad input --------------------------------------------------------------------------

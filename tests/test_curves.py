@@ -1,5 +1,7 @@
-"""Discrete curves (Sections 1.1–1.3): curvatures against exact values and geometric oracles,
-their smooth limits with observed orders, reconstruction, sampling, bad input, plots."""
+"""Discrete curves (Sections 1.1–1.3): curvatures against geometric oracles, the smooth limit on
+a space curve, reconstruction, sampling, bad input, plots.  The statements with exact values on
+circles and the plane smooth limits are `ddgjax verify` checks (`sec1_curves`, run by
+`test_verify_checks.py`)."""
 
 import functools
 
@@ -54,37 +56,6 @@ def random_arc_length_curve(rng, n, dim=3, max_turn=1.0):
 
 
 # --- exact values on circles and regular polygons ------------------------------------------
-
-
-def test_def_1_4_vertex_curvature_is_inverse_radius_for_any_points_on_a_circle(rng):
-    """Three points on a circle span that circle: κ_k = 1/R exactly, whatever the spacing."""
-    R = 1.7
-    angles = np.sort(rng.uniform(0.0, 5.0, size=12))
-    planar = R * np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    spatial = np.column_stack([planar, np.zeros(12)]) @ Q.T  # the same circle in a tilted plane
-    for gamma in (planar, spatial):
-        assert np.max(np.abs(np.asarray(curves.curvature(gamma, "vertex")) - 1 / R)) <= 1e-12
-    assert np.max(np.abs(np.asarray(curves.curvature(planar[::-1], "vertex")) + 1 / R)) <= 1e-12  # clockwise
-
-
-@pytest.mark.parametrize("n", [5, 12])
-def test_def_1_5_1_6_regular_polygon_curvatures_are_its_inscribed_circle(n):
-    """Regular n-gon sampled from the circle of radius R at arc-length spacing ε = 2πR/n.
-
-    φ = 2π/n; edges 2R sin(φ/2).  Vertex kind: the circumcircle, 1/R.  Arc-length kind
-    2 tan(φ/2)/|Δγ| and edge kind (tan(φ/2) + tan(φ/2))/|Δγ| are both 1/(R cos(φ/2)): the
-    inscribed circle touches every edge at its midpoint.
-    """
-    R = 2.5
-    gamma = curves.sample(circle(R), n, length=2 * np.pi * R, closed=True)
-    phi, chord = 2 * np.pi / n, 2 * R * np.sin(np.pi / n)
-    np.testing.assert_allclose(curves.turning_angles(gamma, closed=True), phi, rtol=0, atol=1e-14)
-    np.testing.assert_allclose(curves.edge_lengths(gamma, closed=True), chord, rtol=1e-14)
-    expected = {"vertex": 1 / R, "arclength": 2 * np.tan(phi / 2) / chord, "edge": 1 / (R * np.cos(phi / 2))}
-    assert np.isclose(expected["arclength"], expected["edge"], rtol=1e-14, atol=0)
-    for kind, value in expected.items():
-        np.testing.assert_allclose(curves.curvature(gamma, kind, closed=True), value, rtol=1e-13)
 
 
 def test_turning_angles_signed_in_the_plane_unsigned_in_space():
@@ -153,18 +124,6 @@ def test_remark_1_4_vertex_curvature_of_unit_edges_is_2_sin_half_angle_at_most_2
     assert np.max(kappa) <= 2.0 and np.max(phi) > 2.0  # sharp turns, still bounded
 
 
-def test_remark_2_1_vertex_tangent_length_and_direction(rng):
-    """|v_k| = 2 / |T_k + T_{k−1}| = 1/cos(φ_k/2), along the bisector T_k + T_{k−1}."""
-    gamma = random_arc_length_curve(rng, 12)
-    v = np.asarray(curves.vertex_tangent(gamma))
-    T = np.asarray(curves.tangents(gamma))
-    bisector = T[1:] + T[:-1]
-    speed = np.linalg.norm(v, axis=1)
-    np.testing.assert_allclose(speed, 2 / np.linalg.norm(bisector, axis=1), rtol=1e-13)
-    np.testing.assert_allclose(speed, 1 / np.cos(np.asarray(curves.turning_angles(gamma)) / 2), rtol=1e-12)
-    assert np.max(np.linalg.norm(np.cross(v, bisector), axis=1)) <= 1e-13
-
-
 # --- smooth limits (Section 1.2) -----------------------------------------------------------
 
 
@@ -192,17 +151,6 @@ def assert_order(table, order, tol=0.1):
     assert abs(table.orders[-1] - order) <= tol / 2, table.to_markdown()
 
 
-@pytest.mark.parametrize("kind", ["vertex", "edge", "arclength"])
-def test_section_1_3_curvatures_converge_to_kappa_with_order_2(kind):
-    """Catenary sampled by arc length with equal chords ε: all three discrete curvatures → κ(s),
-    error O(ε²) (observed 2.00 on the finest pairs; the formulas are symmetric in k ± 1)."""
-    table = dg.limits.convergence(
-        functools.partial(curvature_error, kind, *CATENARY, lambda s: 1 / (1 + s**2)),
-        RESOLUTIONS, label=f"max |κ_{kind} − κ|",
-    )
-    assert_order(table, 2.0)
-
-
 @pytest.mark.parametrize("kind", ["vertex", "arclength"])
 def test_section_1_3_space_curvatures_converge_on_a_helix(kind):
     table = dg.limits.convergence(
@@ -210,17 +158,6 @@ def test_section_1_3_space_curvatures_converge_on_a_helix(kind):
         RESOLUTIONS, label=f"max |κ_{kind} − κ| (helix)",
     )
     assert_order(table, 2.0)
-
-
-def test_remark_2_1_vertex_tangent_converges_to_gamma_prime_with_order_2():
-    """(T_k + T_{k−1}) / (1 + <T_k, T_{k−1}>) → γ'(s_k): its length 1/cos(φ_k/2) = 1 + κ²ε²/8 + …
-    and the bisector of the chords is γ' + O(ε²), so the order is 2 (not 1)."""
-
-    def error(n):
-        gamma, s = sampled(*CATENARY, n)
-        return np.max(np.abs(np.asarray(curves.vertex_tangent(gamma)) - np.asarray(derivative(catenary)(s[1:-1]))))
-
-    assert_order(dg.limits.convergence(error, RESOLUTIONS, label="max |v_k − γ'|"), 2.0)
 
 
 # --- reconstruction and sampling -------------------------------------------------------------
@@ -351,17 +288,20 @@ def test_inputs_are_not_mutated(rng):
 # --- plots -----------------------------------------------------------------------------------
 
 
-def test_plots_write_png_files(tmp_path, rng):
+def test_plots_draw_the_polylines(tmp_path, rng):
+    """The figures show the data: one line per curve with the curve's vertices, a closed curve
+    repeats its first vertex, 3-D axes for space curves, one legend entry per label."""
     gamma = random_arc_length_curve(rng, 12)
+    fig = dg.plot.curve(gamma)
+    (line,) = fig.axes[0].lines
+    assert fig.axes[0].name == "3d"
+    np.testing.assert_allclose(np.stack(line.get_data_3d(), axis=1), gamma, rtol=0, atol=1e-15)
+    fig = dg.plot.curve(gamma[:, :2], closed=True, color="k")
+    x, y = fig.axes[0].lines[0].get_data()
+    assert len(x) == len(gamma) + 1 and (x[0], y[0]) == (x[-1], y[-1])
     family = [gamma[:, :2] * a for a in (1.0, 1.5, 2.0)]
-    table = dg.limits.ConvergenceTable.from_errors([8, 16, 32], [1e-2, 2.6e-3, 6.4e-4])
-    paths = [
-        dg.plot.curve(gamma, path=tmp_path / "space.png"),
-        dg.plot.curve(gamma[:, :2], closed=True, path=tmp_path / "plane.png", color="k"),
-        dg.plot.curves(family, labels=["a", "b", "c"], path=tmp_path / "family.png"),
-        dg.plot.convergence(table, tmp_path / "table.png"),
-    ]
-    for path in paths:
-        assert path.exists() and path.stat().st_size > 2000
-    fig = dg.plot.curve(gamma[:, :2])
-    assert fig.axes and fig.axes[0].lines
+    fig = dg.plot.curves(family, labels=["a", "b", "c"])
+    assert [line.get_xdata().max() for line in fig.axes[0].lines] == pytest.approx([f[:, 0].max() for f in family])
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == ["a", "b", "c"]
+    path = dg.plot.curve(gamma, path=tmp_path / "space.png")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

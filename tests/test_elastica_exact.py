@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.special import ellipe, ellipj, ellipk
 
-from ddgjax.elastica_exact import elliptic_e, figure_eight, figure_eight_modulus, inflectional, non_inflectional
+from ddgjax.smooth.elastica import elliptic_e, figure_eight, figure_eight_modulus, inflectional, non_inflectional
 from ddgjax.errors import InvalidInputError
 
 CURVES = {

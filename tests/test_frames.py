@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddgjax import curves, frames, limits
+from ddgjax import curves, frames
 from ddgjax import quaternion as qt
 from ddgjax.errors import InvalidInputError, ShapeError, SingularVertexError
 
@@ -128,21 +128,6 @@ def test_discrete_curvature_is_the_arclength_curvature_of_the_tangent_polyline()
     gamma = curves.from_tangents(T, edge_length=h)
     kappa = curves.curvature(gamma, "arclength")
     assert np.max(np.abs(np.hypot(k1, k2) - kappa)) <= 1e-11  # 1/h = 20 amplifies round-off
-
-
-def test_discrete_curvatures_converge_at_order_2():
-    """Max error of discrete κ1, κ2, τ against the smooth values at the vertices, n = 16..256:
-    the symmetric splitting is second order; fitted orders within 0.02 of 2."""
-    ns = [16, 32, 64, 128, 256]
-    errors = {}
-    for n in ns:
-        Phi, h, exact = sampled_edge_frames(n)
-        discrete = np.asarray(jax.jit(frames.discrete_curvatures, static_argnums=1)(Phi, h))
-        errors[n] = np.max(np.abs(discrete - np.asarray(exact)), axis=1)
-    for which in range(3):
-        table = limits.convergence(lambda n: float(errors[n][which]), ns)
-        assert abs(table.fitted_order - 2) <= 0.02, table.to_markdown()  # observed 1.999–2.000
-        assert table.errors[-1] <= 1e-3
 
 
 def test_pure_twist_is_exact():

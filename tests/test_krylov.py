@@ -7,6 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from ddgjax.problem import flatten_multipliers
 from solvers import solve, solve_batch
 from solvers._krylov import minres
 from solvers._solve import DENSE_MAX, choose_method
@@ -110,7 +111,7 @@ def _kkt_at_solution(problem):
     spec = spec_of(problem)
     sol = solve(problem, method="sparse")
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
-    w = jnp.concatenate([spec.layout.ravel(sol.x)[spec.layout.free], sol.multipliers])
+    w = jnp.concatenate([spec.layout.ravel(sol.x)[spec.layout.free], flatten_multipliers(problem, sol.multipliers)])
     return kkt, w, _choose_algebra(problem, spec, "krylov")
 
 

@@ -177,7 +177,7 @@ def test_bad_meshes_name_the_offender():
 
 
 def test_plots_are_written(tmp_path):
-    from ddgjax import plot_laplace
+    from ddgjax.plot import laplace as plot_laplace
 
     V, F, b = square_grid(8)
     u = np.exp(V[:, 0]) * np.sin(V[:, 1])

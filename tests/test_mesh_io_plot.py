@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from ddgjax import mesh, plot_surface
+from ddgjax import mesh
+from ddgjax.plot import surface as plot_surface
 from ddgjax.errors import InvalidInputError, ShapeError
 
 

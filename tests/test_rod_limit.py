@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import ddgjax as dg
-from ddgjax import kirchhoff
+from ddgjax.smooth import kirchhoff
 from ddgjax import quaternion as qt
 from energies import rod
 from solvers import solve

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from ddgjax import quaternion as qt
-from ddgjax import top
+from ddgjax.smooth import top
 from ddgjax.errors import InvalidInputError, ShapeError
 
 ALPHA = 2.5

@@ -1,20 +1,20 @@
 """Piecewise flat surfaces and intrinsic Delaunay triangulations (Sec 5.3, 7 of the reference).
 
-- geometry: triangles from side lengths (Kahan's area, cotangents, harmonic index, unfolding)
-- triangulation: `Triangulation` (a gluing of triangles with edge lengths, admitting loops,
-  multiple edges and self-glued triangles), `from_faces`, `from_mesh`, `from_gluing`,
-  `corner_angles`, `cone_angles`, `angle_defects`, `unfold`
+- triangulation: `Triangulation` = connectivity (`ddgjax.mesh.Halfedges`: a gluing of triangles
+  admitting loops, multiple edges and self-glued triangles) + edge lengths; `from_faces`,
+  `from_mesh`, `from_gluing`, `corner_angles`, `cone_angles`, `angle_defects`, `cotan_weights`,
+  `unfold` (the geometry is `ddgjax.mesh.lengths`)
+- geometry: unfolding two triangles into the plane (the length of a flipped edge)
 - flips: `flip` (Lemma 5.8), `is_flippable`
 - delaunay: `is_delaunay`, `delaunay_edges` (Prop 7.9), `harmonic_index` (Def 7.7),
   `flip_to_delaunay` (Fig 7.13) -> `FlipResult`
 - rippa: Rippa's formula (Lemma 7.14), circularity (Lemma 7.15)
 - laplace_beltrami: `laplace_beltrami(V, F)` (Def 7.8), `cotan_laplacian`, `delaunay_tessellation`
-- minimal: `minimal_surface_delaunay` (Def 7.9, Fig 7.23)
-- plot: `triangulation` figures with non-Delaunay edges highlighted
+
+Minimal surfaces in the narrow sense (Def 7.9, Fig 7.23) are computed by
+`energies.area.minimal_surface(..., method="delaunay")` / `energies.area.harmonic_iteration`.
 """
 
-from . import minimal as minimal
-from . import plot as plot
 from . import rippa as rippa
 from .delaunay import (
     FlipResult as FlipResult,
@@ -54,7 +54,6 @@ from .laplace_beltrami import (
 from .laplace_beltrami import (
     laplace_beltrami_from_lengths as laplace_beltrami_from_lengths,
 )
-from .minimal import minimal_surface_delaunay as minimal_surface_delaunay
 from .triangulation import (
     Triangulation as Triangulation,
 )

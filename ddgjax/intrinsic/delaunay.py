@@ -15,10 +15,12 @@
   batch (an edge whose triangles change again later is tested again by that later flip, so the
   queue always holds every edge that may be non-Delaunay).  Every flip is one step of Fig 7.13,
   recorded in the history.  The test keys cot + tol · s of all corners and the areas of all
-  faces are cached and updated at each flip, so a test is four array lookups; the cotangents of
-  the result are computed once at the end.  No JIT: numpy's vectorised gathers and scatters,
-  about 0.2–0.35 µs per flip on 10⁶ faces (scattered writes and boolean compressions are the
-  cost, so a flip writes as few entries as it can: see `flips.flip_batch`).
+  faces are cached and updated at each flip, so a test is four array lookups; the cotangents
+  come from the law of cosines (`ddgjax.mesh.lengths.corner_cotangents`).  The cotan weights
+  of the result are not these cotangents but the derived ones (`triangulation.cotan_weights`,
+  the autodiff Hessian of the Dirichlet energy).  No JIT: numpy's vectorised gathers and
+  scatters, where scattered writes and boolean compressions are the cost, so a flip writes as
+  few entries as it can (`flips.flip_batch`).
 
 Surfaces with boundary (which the reference does not treat) keep their boundary edges; only
 interior edges are tested and flipped, as in libigl's `intrinsic_delaunay_triangulation`.
@@ -32,14 +34,21 @@ is Delaunay (Lemma 7.11).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import FlipBudgetError, InvalidInputError
+from ..mesh.lengths import corner_cotangents, face_harmonic_index, triangle_area
 from .flips import flip_batch, others
-from .geometry import face_harmonic_index, flipped_length, triangle_area
-from .triangulation import Triangulation, from_faces, side_lengths
+from .geometry import flipped_length
+from .triangulation import (
+    Triangulation,
+    cotan_weights,
+    from_faces,
+    of_arrays,
+    side_lengths,
+)
 
 __all__ = [
     "DELAUNAY_TOL",
@@ -78,22 +87,20 @@ def _interior(tri: Triangulation) -> np.ndarray:
 
 def _face_geometry(tri: Triangulation):
     """(cot, area, s): per halfedge the cot of the angle opposite it (3 nf,), per face its area
-    and s = (a² + b² + c²)/4A = h(Δ)/4 (nf,).  Side i of a face is opposite its corner i + 2;
-    cot opposite side i = (l_{i+1}² + l_{i+2}² − l_i²)/4A (law of cosines, eq 6.3)."""
+    and s = (a² + b² + c²)/4A = h(Δ)/4 (nf,) (`corner_cotangents`, Lemma 7.17)."""
     L = side_lengths(tri)
     a, b, c = L[:, 0].copy(), L[:, 1].copy(), L[:, 2].copy()  # contiguous columns
     A = triangle_area(a, b, c)
     a2, b2, c2 = a * a, b * b, c * c
-    inv = 0.25 / A
     cots = np.empty_like(L)
-    for i, (p, q, r) in enumerate(((b2, c2, a2), (c2, a2, b2), (a2, b2, c2))):
-        cots[:, i] = (p + q - r) * inv
-    return cots.reshape(-1), A, (a2 + b2 + c2) * inv
+    for i, cot in enumerate(corner_cotangents(a2, b2, c2, A)):
+        cots[:, i] = cot
+    return cots.reshape(-1), A, (a2 + b2 + c2) * (0.25 / A)
 
 
 def edge_cotangent_sums(tri: Triangulation) -> np.ndarray:
-    """(ne,) cot α + cot β of the angles opposite each edge, 2ν(e) of eq 6.2 (one cot on the
-    boundary)."""
+    """(ne,) cot α + cot β of the angles opposite each edge (one cot on the boundary): the angle
+    criterion of Prop 7.9 (law of cosines); the cotan weights are `cotan_weights`."""
     return np.bincount(tri.edge, _face_geometry(tri)[0], minlength=tri.n_edges)
 
 
@@ -138,7 +145,7 @@ class FlipResult:
     ((n_flips + 1,) h(T) before the first and after every flip, or just the first and last value
     when the history was not recorded); `harmonic_index_steps` ((n_flips,) the change of h at each
     flip, all < 0 by Cor 7.19; empty when not recorded); `halfedge_cotangents` ((3 nf,) the cot
-    of the angle opposite each halfedge of the result, used by `cotan_weights()`).
+    of the angle opposite each halfedge of the result, as cached by the angle test).
     """
 
     triangulation: Triangulation
@@ -146,14 +153,12 @@ class FlipResult:
     n_rounds: int
     harmonic_index: np.ndarray
     harmonic_index_steps: np.ndarray
-    halfedge_cotangents: np.ndarray | None = None  # (3 nf,) cot opposite each halfedge, if known
+    halfedge_cotangents: np.ndarray | None = None
 
     def cotan_weights(self) -> np.ndarray:
-        """(ne,) ν(e) = ½ (cot α + cot β) of the Delaunay triangulation (eq 6.2)."""
-        cot = self.halfedge_cotangents
-        if cot is None:
-            cot = _face_geometry(self.triangulation)[0]
-        return 0.5 * np.bincount(self.triangulation.edge, cot, minlength=self.triangulation.n_edges)
+        """(ne,) ν(e) = ½ (cot α + cot β) of the Delaunay triangulation (eq 6.2), derived from
+        the Dirichlet energy (`triangulation.cotan_weights`)."""
+        return cotan_weights(self.triangulation)
 
     @property
     def F(self) -> np.ndarray:
@@ -258,10 +263,10 @@ def _new_face_keys(w: _Work, slots, face, x, y, z):
     B = triangle_area(x, y, z)
     w.area[face] = B
     s, (x2, y2, z2) = _sums_of_squares(x, y, z, B)
-    inv, shift = 0.25 / B, w.tol * s
+    shift = w.tol * s
     keys = []
-    for slot, (p, q, r) in zip(slots, ((y2, z2, x2), (z2, x2, y2), (x2, y2, z2))):
-        w.key[slot] = k = (p + q - r) * inv + shift
+    for slot, cot in zip(slots, corner_cotangents(x2, y2, z2, B)):
+        w.key[slot] = k = cot + shift
         keys.append(k)
     return s, keys
 
@@ -359,7 +364,7 @@ def flip_owned(tri: Triangulation, tol: float = DELAUNAY_TOL, max_flips: int | N
         n_rounds += n_flips > before
     out, (cots, _, scales) = tri, geometry
     if n_flips:
-        out = replace(tri, F=w.F.reshape(-1, 3), edge=w.edge, halfedges=w.halfedges, lengths=w.lengths)
+        out = of_arrays(w.F, w.edge, w.halfedges, w.lengths, tri.n_vertices)
         cots, scales = w.cotangents()
     steps = np.concatenate(steps) if steps else np.zeros(0)
     history = h0 + np.concatenate([[0.0], np.cumsum(steps)]) if record_history else np.array([h0, 4.0 * float(scales.sum())])

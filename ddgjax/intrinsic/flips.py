@@ -13,13 +13,12 @@ flipping them one after the other in any order.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from ..errors import MeshError
-from .geometry import apex, flipped_length, triangle_area
-from .triangulation import Triangulation
+from ..mesh.lengths import triangle_area
+from .geometry import apex, flipped_length
+from .triangulation import Triangulation, of_arrays
 
 __all__ = ["flip", "flip_batch", "is_flippable", "others", "quad"]
 
@@ -103,4 +102,4 @@ def flip(tri: Triangulation, e: int) -> Triangulation:
         )
     F, edge, halfedges, lengths = tri.F.reshape(-1).copy(), tri.edge.copy(), tri.halfedges.copy(), tri.lengths.copy()
     flip_batch(F, edge, halfedges, lengths, np.array([e]))
-    return replace(tri, F=F.reshape(-1, 3), edge=edge, halfedges=halfedges, lengths=lengths)
+    return of_arrays(F, edge, halfedges, lengths, tri.n_vertices)

@@ -1,47 +1,18 @@
-"""Euclidean triangles from their side lengths alone (Sec 5.3): area, cotangents, harmonic index,
-unfolding of two triangles into the plane.
+"""Two Euclidean triangles unfolded into the plane from their side lengths (Lemma 5.8, Fig 5.11):
+the apex of a triangle over a base, and the other diagonal of the quadrilateral of two triangles
+glued along an edge (the length of a flipped edge).
 
-Every function is vectorised over numpy arrays of side lengths (any common shape) and does no
-validation; `triangulation.py` checks the triangle inequalities once at the API boundary.
+Vectorised over numpy arrays of side lengths, no validation; the areas are Kahan's
+(`ddgjax.mesh.lengths.triangle_area`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["apex", "cotangent", "face_harmonic_index", "flipped_length", "triangle_area"]
+from ..mesh.lengths import triangle_area
 
-
-def _sorted3(a, b, c):
-    """(x, y, z) with x ≥ y ≥ z elementwise, exactly (min / max only, no arithmetic)."""
-    x = np.maximum(np.maximum(a, b), c)
-    z = np.minimum(np.minimum(a, b), c)
-    y = np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c))
-    return x, y, z
-
-
-def triangle_area(a, b, c):
-    """Area of the Euclidean triangle with sides a, b, c by Heron's formula in Kahan's stable
-    order, sides sorted x ≥ y ≥ z:
-
-        A = ¼ √((x + (y + z)) (z − (x − y)) (z + (x − y)) (x + (y − z))),
-
-    accurate for needle-like triangles (no cancellation of rounded sums).
-    """
-    x, y, z = _sorted3(a, b, c)
-    return 0.25 * np.sqrt((x + (y + z)) * (z - (x - y)) * (z + (x - y)) * (x + (y - z)))
-
-
-def cotangent(a, b, c, area):
-    """cot α of the angle α opposite the side a: cot α = (b² + c² − a²) / (4 A) (law of cosines
-    over twice the area; used in eq 6.2 and Lemma 7.17).
-    """
-    return (b * b + c * c - a * a) / (4.0 * area)
-
-
-def face_harmonic_index(a, b, c, area):
-    """h(Δ) = (a² + b² + c²) / A(Δ) (Def 7.7), = 4 (cot α + cot β + cot γ) by Lemma 7.17."""
-    return (a * a + b * b + c * c) / area
+__all__ = ["apex", "flipped_length"]
 
 
 def apex(base, left, right, area, side: float = 1.0):

@@ -10,6 +10,9 @@ Delaunay tessellation, and the others do not depend on how the polygons were tri
 
 is a property of the metric alone (Remark 7.9): the same for every Delaunay triangulation and for
 every isometric deformation of a polyhedral surface (Example 5.3) [Bobenko–Springborn 2007].
+It is `ddgjax.laplace`'s derived cotan Laplacian (the autodiff Hessian of the Dirichlet energy on
+squared lengths, Thm 6.6) composed with the flip algorithm: `cotan_laplacian(tri)` on the
+lengths of `tri`, `laplace_beltrami(V, F)` on those of the intrinsic Delaunay triangulation.
 Sign convention as `ddgjax.laplace.cotan_laplacian`: positive semidefinite, L·1 = 0, L_ij = −ν
 off the diagonal; the negative of libigl's `cotmatrix`, equal to geometry-central's / robust-
 laplacian's `L`.  Multiple edges between two vertices add their weights; loops drop out.
@@ -27,18 +30,20 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import DDGError
+from ..laplace import laplacian_of_edge_weights
+from ..mesh.lengths import face_harmonic_index, triangle_area
 from .delaunay import (
     DELAUNAY_TOL,
     as_triangulation,
     edge_cotangent_sums,
     flip_owned,
 )
-from .geometry import face_harmonic_index, triangle_area
 from .ordering import is_local, local_numbering
 from .triangulation import (
     Triangulation,
     checked_faces,
     checked_positions,
+    cotan_weights,
     from_checked_mesh,
     from_mesh,
     next_halfedge,
@@ -55,39 +60,24 @@ __all__ = [
 ]
 
 
-def cotan_weights(tri: Triangulation) -> np.ndarray:
-    """(ne,) ν(e) = ½ (cot α + cot β), ½ cot α on the boundary (eq 6.2), in edge order of `tri`."""
-    return 0.5 * edge_cotangent_sums(tri)
-
-
-def cotan_laplacian(tri: Triangulation, weights=None, labels=None) -> sp.csr_matrix:
+def cotan_laplacian(tri: Triangulation, labels=None) -> sp.csr_matrix:
     """The cotan Laplace operator of the geodesic triangulation `tri` (Def 6.2) as an
-    (nv, nv) `csr_matrix` L with (L f)_i = Σ_j ν_ij (f_i − f_j); `weights` the ν (ne,) if
-    already known (default `cotan_weights(tri)`); `labels` (nv,) the row of each vertex of `tri`
-    (default the identity).
+    (nv, nv) `csr_matrix` L with (L f)_i = Σ_j ν_ij (f_i − f_j), ν the derived weights
+    `cotan_weights(tri)` (the autodiff Hessian of the Dirichlet energy on the lengths of `tri`),
+    assembled by `ddgjax.laplace.laplacian_of_edge_weights` (multiple edges add their weights,
+    loops drop out); `labels` (nv,) the row of each vertex of `tri` (default the identity).
     """
-    w = cotan_weights(tri) if weights is None else weights
-    n = tri.n_vertices
-    index = np.int32 if n < np.iinfo(np.int32).max else np.int64  # scipy's own index type
-    F = tri.F.reshape(-1).astype(index)
-    h, t = tri.halfedges[:, 0], tri.halfedges[:, 1]
-    i, j = F[h], F[t]  # the head of h is the tail of its twin t
-    boundary = np.flatnonzero(t < 0)
-    j[boundary] = F[next_halfedge(h[boundary])]
+    F = tri.F.reshape(-1)
+    h = tri.halfedges[:, 0]
+    i, j = F[h], F[next_halfedge(h)]
     if labels is not None:
-        i, j = labels[i].astype(index), labels[j].astype(index)
-    w = np.where(i != j, w, 0.0)  # loops drop out
-    diagonal = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
-    vertices = np.arange(n, dtype=index)
-    rows = np.concatenate([i, j, vertices])
-    cols = np.concatenate([j, i, vertices])
-    return sp.csr_matrix((np.concatenate([-w, -w, diagonal]), (rows, cols)), shape=(n, n))
+        i, j = labels[i], labels[j]
+    return laplacian_of_edge_weights(i, j, cotan_weights(tri), tri.n_vertices)
 
 
 def _delaunay_laplacian(tri: Triangulation, tol: float, labels=None, owned: bool = False) -> sp.csr_matrix:
     """`owned`: `tri` was built here, its arrays may be flipped in place."""
-    result = flip_owned(tri, tol, copy=not owned)
-    return cotan_laplacian(result.triangulation, result.cotan_weights(), labels)
+    return cotan_laplacian(flip_owned(tri, tol, copy=not owned).triangulation, labels)
 
 
 def laplace_beltrami_from_lengths(F, lengths=None, *, tol: float = DELAUNAY_TOL) -> sp.csr_matrix:

@@ -1,9 +1,11 @@
 """Piecewise flat surfaces as glued Euclidean triangles (Sec 5.3, Def 5.5, 5.6).
 
-A geodesic triangulation is stored as a gluing map plus edge lengths, not as vertex triples, so
-that it admits the non-regular triangulations the edge-flip algorithm produces (Remark 5.9,
-Example 7.2): a triangle glued to itself, loops, two edges between the same pair of vertices,
-vertices of valence one.
+A geodesic triangulation is connectivity plus edge lengths: a `ddgjax.mesh.Halfedges` of
+triangles (the one connectivity type of ddgjax) and one length per edge satisfying every triangle
+inequality strictly.  The gluing admits the non-regular triangulations the edge-flip algorithm
+produces (Remark 5.9, Example 7.2): a triangle glued to itself, loops, two edges between the same
+pair of vertices, vertices of valence one.  All geometry comes from the lengths
+(`ddgjax.mesh.lengths`).
 
 Side `i` of face `f` is the halfedge `h = 3 f + i`, running from corner `i` to corner `i + 1`
 of the face (indices mod 3).  The faces are oriented consistently: two glued halfedges run in
@@ -12,88 +14,114 @@ opposite directions.  Arrays:
 - `F` (nf, 3) int: the vertex at each corner (vertex labels; after flips a face may repeat one);
 - `edge` (3 nf,) int: the edge each halfedge lies on;
 - `halfedges` (ne, 2) int: the two halfedges of each edge, `[e, 1] = -1` on the boundary;
-- `lengths` (ne,) float: the edge lengths, satisfying every triangle inequality strictly.
+- `lengths` (ne,) float: the edge lengths.
 
 The angle at corner k of a face lies opposite its side k + 1.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ..errors import (
     GluingError,
     MeshError,
     NonFiniteError,
-    NonManifoldError,
-    OrientationError,
     ShapeError,
     TriangleInequalityError,
 )
-from .geometry import apex, cotangent, triangle_area
+from ..mesh.connectivity import (
+    Halfedges,
+    checked_triangles,
+    from_twins,
+    glue_triangles,
+    next_halfedge,
+)
+from ..mesh.lengths import angle_defects as angle_defects_of_sides
+from ..mesh.lengths import corner_angles_of_sides, half_cotangents, triangle_area
+from ..mesh.lengths import corner_cotangents as cotangents_of_sides
+from .geometry import apex
 
 __all__ = [
     "Triangulation",
     "angle_defects",
     "boundary_vertices",
+    "checked_faces",
     "cone_angles",
     "corner_angles",
     "corner_cotangents",
+    "corner_weights",
+    "cotan_weights",
     "from_checked_mesh",
     "from_faces",
     "from_gluing",
     "from_mesh",
     "next_halfedge",
+    "opposite_side_lengths",
     "side_lengths",
     "unfold",
 ]
 
+checked_faces = checked_triangles
+
 
 @dataclass(frozen=True, eq=False)
 class Triangulation:
-    """A geodesic triangulation of a piecewise flat surface (Def 5.6); see the module docstring
-    for the meaning of the arrays.  Immutable: operations return new triangulations.
+    """A geodesic triangulation of a piecewise flat surface (Def 5.6): `connectivity` (triangles
+    glued consistently oriented, h = 3 f + i) and `lengths` (ne,).  Immutable: operations return
+    new triangulations.  The arrays `F`, `edge`, `halfedges`, `twin`, `edges` and the counts are
+    those of the connectivity (module docstring).
     """
 
-    F: np.ndarray
-    edge: np.ndarray
-    halfedges: np.ndarray
+    connectivity: Halfedges
     lengths: np.ndarray
-    n_vertices: int
+
+    @property
+    def F(self) -> np.ndarray:
+        return self.connectivity.F
+
+    @property
+    def edge(self) -> np.ndarray:
+        return self.connectivity.edge
+
+    @property
+    def halfedges(self) -> np.ndarray:
+        return self.connectivity.halfedges
+
+    @property
+    def n_vertices(self) -> int:
+        return self.connectivity.n_vertices
 
     @property
     def n_faces(self) -> int:
-        return int(self.F.shape[0])
+        return self.connectivity.n_faces
 
     @property
     def n_edges(self) -> int:
-        return int(self.halfedges.shape[0])
+        return self.connectivity.n_edges
 
     @property
     def twin(self) -> np.ndarray:
         """(3 nf,) the halfedge glued to each halfedge, -1 on the boundary."""
-        pair = self.halfedges[self.edge]
-        return np.where(pair[:, 0] == np.arange(self.edge.size), pair[:, 1], pair[:, 0])
+        return self.connectivity.twin
 
     @property
     def edges(self) -> np.ndarray:
-        """(ne, 2) the endpoints (tail, head) of each edge's first halfedge."""
-        h = self.halfedges[:, 0]
-        return np.stack([self.F.reshape(-1)[h], self.F.reshape(-1)[next_halfedge(h)]], axis=1)
+        """(ne, 2) the endpoints of each edge in its canonical direction (`Halfedges.edges`)."""
+        return self.connectivity.edges
 
     def with_lengths(self, lengths) -> Triangulation:
         """The same gluing with other edge lengths (validated)."""
-        return _validated(replace(self, lengths=np.array(lengths, dtype=np.float64)))
+        return _validated(Triangulation(self.connectivity, np.array(lengths, dtype=np.float64)))
 
 
-def next_halfedge(h):
-    """The next halfedge in the same face: 3 f + (i + 1 mod 3)."""
-    h = np.asarray(h)
-    return np.where(h - 3 * (h // 3) == 2, h - 2, h + 1)
+def of_arrays(F, edge, halfedges, lengths, n_vertices: int) -> Triangulation:
+    """The triangulation of the flat arrays of a consistently oriented triangle gluing (as the
+    flip loop keeps them), not validated."""
+    F = np.asarray(F).reshape(-1)
+    return Triangulation(Halfedges(F, edge, halfedges, int(n_vertices), F.size // 3), lengths)
 
 
 def side_lengths(tri: Triangulation) -> np.ndarray:
@@ -131,91 +159,6 @@ def _validated(tri: Triangulation) -> Triangulation:
     return tri
 
 
-def _glue_by_keys(keys: np.ndarray):
-    """Group halfedges with equal keys into edges, with one sort.
-
-    Returns `(edge, halfedges, unique_keys, count)`: the edge of each halfedge, numbered in
-    increasing key order (for keys lo · nv + hi this is the lexicographic order of
-    `ddgjax.mesh.edges(F)`); the (ne, 2) halfedges of each edge (-1 in column 1 where there is
-    one; only the first two are kept); the sorted distinct keys and their multiplicities.
-    """
-    order = np.argsort(keys, kind="stable")
-    sorted_keys = keys[order]
-    n = keys.size
-    if n % 2 == 0 and n and np.array_equal(sorted_keys[0::2], sorted_keys[1::2]) and np.all(sorted_keys[2::2] != sorted_keys[1:-1:2]):
-        # every key exactly twice (a closed surface): the pairs are consecutive
-        edge = np.empty(n, dtype=np.int64)
-        edge[order] = np.arange(n) >> 1
-        return edge, order.reshape(-1, 2), sorted_keys[0::2], np.full(n // 2, 2)
-    is_start = np.empty(keys.size, dtype=bool)
-    is_start[:1] = True
-    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=is_start[1:])
-    starts = np.flatnonzero(is_start)
-    count = np.diff(np.append(starts, keys.size))
-    edge = np.empty(keys.size, dtype=np.int64)
-    edge[order] = np.cumsum(is_start) - 1
-    halfedges = np.full((starts.size, 2), -1, dtype=np.int64)
-    halfedges[:, 0] = order[starts]
-    two = count >= 2
-    halfedges[:, 1][two] = order[starts[two] + 1]  # column view: row-wise masks are slow
-    return edge, halfedges, sorted_keys[starts], count
-
-
-def _faces_array(F) -> np.ndarray:
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3:
-        raise ShapeError(f"F must be an (nf, 3) array of triangles, got shape {F.shape}")
-    if F.size and not np.issubdtype(F.dtype, np.integer) and not np.all(F == np.round(F)):
-        f = int(np.argwhere(F != np.round(F))[0, 0])
-        raise MeshError(f"face {f} has a non-integer vertex index {F[f].tolist()}")
-    F = F.astype(np.int64)
-    if F.size and F.min() < 0:
-        raise MeshError(f"face {int(np.argwhere(F < 0)[0, 0])} has a negative vertex index")
-    repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-    if repeated.any():
-        f = int(np.argmax(repeated))
-        raise MeshError(f"face {f} repeats a vertex: {F[f].tolist()}")
-    return F
-
-
-def checked_faces(F, n_vertices: int | None = None):
-    """`(F, nv)`: F as an (nf, 3) int64 array of labels < nv (default max + 1); raises `ShapeError`
-    / `MeshError` naming the face."""
-    F = _faces_array(F)
-    nv = int(F.max()) + 1 if n_vertices is None else int(n_vertices)
-    if F.size and F.max() >= nv:
-        raise MeshError(f"face {int(np.argwhere(F >= nv)[0, 0])} has a vertex index >= n_vertices = {nv}")
-    return F, nv
-
-
-def _glue_faces(F: np.ndarray, nv: int):
-    """(edge, halfedges, keys) of faces given by vertex triples; keys = i · nv + j, i < j."""
-    tail = F.reshape(-1)
-    head = np.empty_like(F)
-    head[:, :2] = F[:, 1:]
-    head[:, 2] = F[:, 0]
-    head = head.reshape(-1)
-    lo = np.minimum(tail, head)
-    lo *= np.int64(nv)
-    lo += np.maximum(tail, head)
-    edge, halfedges, keys, count = _glue_by_keys(lo)
-    if np.any(count > 2):
-        e = int(np.argmax(count > 2))
-        raise NonManifoldError(
-            f"edge {e} with vertices ({keys[e] // nv}, {keys[e] % nv}) lies in {count[e]} faces; "
-            "a surface edge lies in at most two"
-        )
-    h, t = halfedges[:, 0], halfedges[:, 1]  # column views (row gathers are slow)
-    same = (t >= 0) & (tail[h] == tail[t])
-    if same.any():
-        e = int(np.argmax(same))
-        raise OrientationError(
-            f"edge {e} with vertices ({keys[e] // nv}, {keys[e] % nv}) is traversed in the same "
-            "direction by its two faces; orient the faces consistently (ddgjax.mesh.orient)"
-        )
-    return edge, halfedges, keys
-
-
 def from_faces(F, lengths, n_vertices: int | None = None) -> Triangulation:
     """The triangulation of a simplicial surface given by vertex triples, with edge `lengths`
     ordered like `ddgjax.mesh.edges(F)` (lexicographic vertex pairs i < j).
@@ -225,9 +168,9 @@ def from_faces(F, lengths, n_vertices: int | None = None) -> Triangulation:
     faces; `OrientationError` for two faces traversing an edge in the same direction;
     `NonFiniteError` / `TriangleInequalityError` for bad lengths (naming the edge or face).
     """
-    F, nv = checked_faces(F, n_vertices)
-    edge, halfedges, _ = _glue_faces(F, nv)
-    return _validated(Triangulation(F, edge, halfedges, np.array(lengths, dtype=np.float64), nv))
+    F, nv = checked_triangles(F, n_vertices)
+    connectivity, _ = glue_triangles(F, nv)
+    return _validated(Triangulation(connectivity, np.array(lengths, dtype=np.float64)))
 
 
 def checked_positions(V) -> np.ndarray:
@@ -246,95 +189,86 @@ def from_mesh(V, F) -> Triangulation:
     Raises as `from_faces`, and `NonFiniteError` for NaN / inf coordinates (naming the vertex).
     """
     V = checked_positions(V)
-    F, _ = checked_faces(F, V.shape[0])
+    F, _ = checked_triangles(F, V.shape[0])
     return from_checked_mesh(V, F)
 
 
 def from_checked_mesh(V: np.ndarray, F: np.ndarray) -> Triangulation:
-    """`from_mesh` for V, F already passed through `checked_positions` / `checked_faces`."""
+    """`from_mesh` for V, F already passed through `checked_positions` / `checked_triangles`."""
     nv = V.shape[0]
-    edge, halfedges, keys = _glue_faces(F, nv)
+    connectivity, keys = glue_triangles(F, nv)
     lo = keys // nv
     d = np.take(V, keys - lo * nv, axis=0) - np.take(V, lo, axis=0)  # take: fancy row indexing is slow
-    lengths = np.sqrt(np.einsum("ij,ij->i", d, d))
-    return _validated(Triangulation(F, edge, halfedges, lengths, nv))
-
-
-def _check_gluing(twin: np.ndarray) -> None:
-    n = twin.size
-    if n % 3:
-        raise ShapeError(f"twin must have 3 entries per triangle, got {n}")
-    bad = np.flatnonzero((twin < -1) | (twin >= n))
-    if bad.size:
-        raise GluingError(f"halfedge {bad[0]} is glued to {twin[bad[0]]}, outside 0..{n - 1}")
-    bad = np.flatnonzero(twin == np.arange(n))
-    if bad.size:
-        raise GluingError(f"halfedge {bad[0]} (side {bad[0] % 3} of face {bad[0] // 3}) is glued to itself")
-    glued = np.flatnonzero(twin >= 0)
-    bad = glued[twin[twin[glued]] != glued]
-    if bad.size:
-        h = int(bad[0])
-        raise GluingError(
-            f"halfedge {h} (side {h % 3} of face {h // 3}) is glued to {twin[h]}, which is glued to "
-            f"{twin[twin[h]]}; a gluing must pair sides"
-        )
+    return _validated(Triangulation(connectivity, np.sqrt(np.einsum("ij,ij->i", d, d))))
 
 
 def from_gluing(twin, side_lengths) -> Triangulation:
     """The piecewise flat surface of triangles glued along sides (Sec 5.3): halfedge `h` (side
     h mod 3 of face h // 3) is glued to `twin[h]` (-1: boundary), reversing direction, and side i
-    of face f has length `side_lengths[f, i]`.  Vertices are the classes of corners that the
-    gluing identifies; a face may be glued to itself, and loops and multiple edges are allowed.
-    Edges are numbered in order of their first halfedge.
+    of face f has length `side_lengths[f, i]` (connectivity: `ddgjax.mesh.from_twins`).
 
     **Raises:** `GluingError` for an index out of range, a side glued to itself, a gluing that is
     not an involution, or glued sides of different lengths (naming the halfedge);
     `TriangleInequalityError` / `NonFiniteError` for bad lengths (naming the face or edge).
     Glued sides must agree to a relative 1e-12; the edge takes the length of its first side.
     """
-    twin = np.asarray(twin, dtype=np.int64).reshape(-1)
-    _check_gluing(twin)
+    connectivity = from_twins(twin)
+    twin = connectivity.twin
     L = np.asarray(side_lengths, dtype=np.float64)
-    if L.shape != (twin.size // 3, 3):
-        raise ShapeError(f"side_lengths must have shape ({twin.size // 3}, 3), got {L.shape}")
-    h = np.arange(twin.size)
+    if L.shape != (connectivity.n_faces, 3):
+        raise ShapeError(f"side_lengths must have shape ({connectivity.n_faces}, 3), got {L.shape}")
     flat = L.reshape(-1)
     glued = twin >= 0
-    mismatch = glued & ~np.isclose(flat, flat[np.where(glued, twin, h)], rtol=1e-12, atol=0) & np.isfinite(flat)
+    other = flat[np.where(glued, twin, np.arange(twin.size))]
+    mismatch = glued & ~np.isclose(flat, other, rtol=1e-12, atol=0) & np.isfinite(flat)
     if mismatch.any():
         b = int(np.argmax(mismatch))
         raise GluingError(f"halfedge {b} has length {flat[b]} but is glued to halfedge {twin[b]} of length {flat[twin[b]]}")
-    first = np.where(glued, np.minimum(h, twin), h)
-    owners, edge = np.unique(first, return_inverse=True)
-    halfedges = np.stack([owners, np.where(twin[owners] >= 0, twin[owners], -1)], axis=1)
-    # the tail of h is the head of its twin, i.e. the tail of next(twin)
-    a = h[glued]
-    graph = sp.coo_matrix((np.ones(a.size), (a, next_halfedge(twin[a]))), shape=(h.size, h.size))
-    n_vertices, vertex = connected_components(graph, directed=False)
-    return _validated(Triangulation(vertex.reshape(-1, 3).astype(np.int64), edge.reshape(-1), halfedges,
-                                    flat[owners].copy(), int(n_vertices)))
+    return _validated(Triangulation(connectivity, flat[connectivity.halfedges[:, 0]].copy()))
 
 
-def _opposite_and_adjacent(tri: Triangulation):
-    """Per corner k: (a, b, c, A) with a the opposite side k + 1, b and c the sides k + 2 and k
-    at the corner, A the face area; each (nf, 3)."""
-    L = side_lengths(tri)
-    A = triangle_area(L[:, 0], L[:, 1], L[:, 2])[:, None]
-    return np.roll(L, -1, axis=1), np.roll(L, -2, axis=1), L, A
+def _opposite_edges(tri: Triangulation) -> np.ndarray:
+    """(nf, 3): the edge opposite corner k of each face (side k + 1)."""
+    return tri.edge.reshape(-1, 3)[:, [1, 2, 0]]
+
+
+def opposite_side_lengths(tri: Triangulation) -> np.ndarray:
+    """(nf, 3): entry [f, k] is the length of the side opposite corner k (side k + 1), the
+    layout of `ddgjax.mesh.lengths`."""
+    return tri.lengths[_opposite_edges(tri)]
 
 
 def corner_cotangents(tri: Triangulation) -> np.ndarray:
-    """(nf, 3): cot of the angle at corner k, (b² + c² − a²) / 4A with a the opposite side."""
-    a, b, c, A = _opposite_and_adjacent(tri)
-    return cotangent(a, b, c, A)
+    """(nf, 3): cot of the angle at corner k (`ddgjax.mesh.lengths.corner_cotangents`)."""
+    L = opposite_side_lengths(tri)
+    a, b, c = L[:, 0], L[:, 1], L[:, 2]
+    return np.stack(cotangents_of_sides(a * a, b * b, c * c, triangle_area(a, b, c)), axis=1)
+
+
+def _weights_at_opposite_edges(tri: Triangulation) -> tuple[np.ndarray, np.ndarray]:
+    """`(w, edges)`, (nf, 3) each: ½ cot α_k derived by autodiff and the edge opposite corner k."""
+    opposite = _opposite_edges(tri)
+    L = tri.lengths[opposite]
+    return half_cotangents(L * L)[0], opposite
+
+
+def corner_weights(tri: Triangulation) -> np.ndarray:
+    """(nf, 3): ½ cot α_k, each face's contribution to the cotan weight of the side opposite its
+    corner k, derived as the off-diagonal of the Hessian of the Dirichlet energy on the squared
+    lengths (`ddgjax.mesh.lengths.half_cotangents`, Thm 6.6)."""
+    return _weights_at_opposite_edges(tri)[0]
+
+
+def cotan_weights(tri: Triangulation) -> np.ndarray:
+    """(ne,) ν(e) = ½ (cot α + cot β), ½ cot α on the boundary (eq 6.2), in edge order of `tri`:
+    the sum of `corner_weights` over the corners opposite each edge."""
+    w, opposite = _weights_at_opposite_edges(tri)
+    return np.bincount(opposite.reshape(-1), w.reshape(-1), minlength=tri.n_edges)
 
 
 def corner_angles(tri: Triangulation) -> np.ndarray:
-    """(nf, 3): the angle at corner k from the lengths alone, atan2(4A, b² + c² − a²) with a the
-    opposite side (the law of cosines; stable near 0 and π).
-    """
-    a, b, c, A = _opposite_and_adjacent(tri)
-    return np.arctan2(4.0 * A, b * b + c * c - a * a)
+    """(nf, 3): the angle at corner k from the lengths alone (`ddgjax.mesh.lengths.corner_angles`)."""
+    return corner_angles_of_sides(opposite_side_lengths(tri))
 
 
 def cone_angles(tri: Triangulation) -> np.ndarray:
@@ -344,18 +278,15 @@ def cone_angles(tri: Triangulation) -> np.ndarray:
 
 def boundary_vertices(tri: Triangulation) -> np.ndarray:
     """(nv,) bool: vertices on a boundary edge."""
-    h = tri.halfedges[tri.halfedges[:, 1] < 0, 0]
-    mask = np.zeros(tri.n_vertices, dtype=bool)
-    mask[tri.F.reshape(-1)[h]] = True
-    mask[tri.F.reshape(-1)[next_halfedge(h)]] = True
-    return mask
+    return tri.connectivity.boundary_vertex_mask
 
 
 def angle_defects(tri: Triangulation) -> np.ndarray:
     """(nv,) K(p) = 2π − θ(p) at interior vertices, π − θ(p) at boundary vertices, θ the cone
-    angle (Def 5.2, Remark 5.4, Thm 5.5); a function of the lengths alone.
+    angle (Def 5.2, Remark 5.4, Thm 5.5); a function of the lengths alone
+    (`ddgjax.mesh.lengths.angle_defects`).
     """
-    return np.where(boundary_vertices(tri), np.pi, 2 * np.pi) - cone_angles(tri)
+    return np.asarray(angle_defects_of_sides(tri.connectivity, opposite_side_lengths(tri)))
 
 
 def unfold(tri: Triangulation, e: int) -> np.ndarray:

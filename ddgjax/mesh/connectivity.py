@@ -1,67 +1,165 @@
-"""Halfedge arrays of a cell decomposition (Def 4.3), orientable or not.
+"""Halfedge arrays of a cell decomposition (Def 4.3): the one connectivity type of ddgjax.
 
 A face with k corners contributes k halfedges; halfedge `h` leaves the vertex of corner `h` and
-ends at the vertex of corner `next[h]` of the same face, so halfedges and corners share one index.
-Each halfedge lies on an undirected edge `edge[h]` and runs along that edge's canonical direction
-(`sign[h] = +1`, from `edges[e, 0]` to `edges[e, 1]`) or against it (`sign[h] = -1`).  `twin[h]` is
-the other halfedge of the same edge, `-1` on the boundary.
+ends at the vertex of corner `next[h]` of the same face, so halfedges and corners share one index
+(for triangles given as an (nf, 3) array, h = 3 f + i).  Each halfedge lies on an undirected edge
+`edge[h]` and runs along that edge's canonical direction (`sign[h] = +1`, from `edges[e, 0]` to
+`edges[e, 1]`) or against it (`sign[h] = -1`).  `halfedges[e]` are the (at most two) halfedges of
+edge e, `-1` in column 1 on the boundary; `twin[h]` is the other halfedge of the same edge.
 
-Nothing here assumes a consistent orientation: at an edge the two faces may traverse it in the
-same direction (a Möbius strip or a projective plane given face by face).  Orientability is a
-property computed from the signs (`topology.is_orientable`), not a precondition.
+Nothing here assumes a consistent orientation, nor that vertices are distinct: at an edge the two
+faces may traverse it in the same direction (a Möbius strip or a projective plane given face by
+face); in a gluing a face may touch itself, an edge may be a loop and two edges may join the same
+two vertices (the Δ-complexes of the flip algorithm, Remark 5.9).  Orientability is computed from
+the signs (`topology.is_orientable`), not a precondition.  Edges are indexed by halfedge, never by
+vertex pair.
 
-Two constructors: `from_faces(F)` for faces given by vertex indices (an (nf, k) array or a list of
-polygons), where vertices are labels and the surface must be a manifold; and `from_gluing(...)`
-for polygons whose edges are glued by labels (`gluing.py`), where vertices are the classes of
-corners that the gluing identifies and faces may touch themselves.
+Constructors: `from_faces(F)` for faces given by vertex labels (manifold checks), `glue_triangles`
+for consistently oriented triangles (the fast path of the intrinsic triangulations), `from_gluing`
+for polygons glued along labelled sides, `from_twins` for triangles glued by an involution of
+their sides; in the last two, vertices are the classes of corners that the gluing identifies.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import MeshError, NonManifoldError, ShapeError
+from ..errors import (
+    GluingError,
+    InvalidInputError,
+    MeshError,
+    NonManifoldError,
+    OrientationError,
+    ShapeError,
+)
 
-__all__ = ["Halfedges", "from_faces", "from_gluing", "as_halfedges", "edges", "faces_as_corners"]
+__all__ = [
+    "Halfedges",
+    "as_halfedges",
+    "boundary_indices",
+    "boundary_vertices",
+    "edges",
+    "faces_as_corners",
+    "from_faces",
+    "from_gluing",
+    "from_twins",
+    "glue_triangles",
+    "next_halfedge",
+]
+
+
+def next_halfedge(h):
+    """The next halfedge in the same triangle: 3 f + (i + 1 mod 3)."""
+    h = np.asarray(h)
+    return np.where(h - 3 * (h // 3) == 2, h - 2, h + 1)
 
 
 @dataclass(frozen=True, eq=False)
 class Halfedges:
-    """Halfedge arrays of a cell decomposition; every array has shape (nh,) unless stated.
+    """Halfedge arrays of a cell decomposition (module docstring).
 
-    **Fields:**
-    - `vertex`: the vertex the halfedge leaves (= the vertex of corner h).
-    - `face`, `next`, `prev`: the face of h and the following / preceding halfedge in that face.
-    - `edge`, `sign`: the undirected edge and the direction (±1) in which h runs along it.
-    - `twin`: the other halfedge on the same edge, -1 on a boundary edge.
-    - `edges`: (ne, 2) endpoints of each edge in its canonical direction.
-    - `n_vertices`, `n_faces`: counts (vertex labels are 0..n_vertices-1; a label that no face
-      uses is not counted by `topology.euler_characteristic`).
+    **Fields:** `vertex` (nh,) the vertex each halfedge leaves (= the vertex of corner h);
+    `edge` (nh,) its edge; `halfedges` (ne, 2) the halfedges of each edge (-1 in column 1 on the
+    boundary); `n_vertices`, `n_faces`.  Optional, for polygons or non-oriented gluings (default:
+    triangles h = 3 f + i, consistently oriented): `face_of`, `next_of` (nh,), `sign_of` (nh,) and
+    `edge_ends` (ne, 2).
+
+    **Properties** (computed on first use): `face`, `next`, `prev`, `head`, `twin`, `sign`,
+    `edges` (the endpoints of each edge in its canonical direction: `edge_ends`, or the tail and
+    head of `halfedges[e, 0]`), `F` (nf, 3) for triangles, `n_edges`, `boundary_vertex_mask`.
     """
 
     vertex: np.ndarray
-    face: np.ndarray
-    next: np.ndarray
-    prev: np.ndarray
     edge: np.ndarray
-    sign: np.ndarray
-    twin: np.ndarray
-    edges: np.ndarray
+    halfedges: np.ndarray
     n_vertices: int
     n_faces: int
+    face_of: np.ndarray | None = field(default=None, repr=False)
+    next_of: np.ndarray | None = field(default=None, repr=False)
+    sign_of: np.ndarray | None = field(default=None, repr=False)
+    edge_ends: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def n_edges(self) -> int:
-        return int(self.edges.shape[0])
+        return int(self.halfedges.shape[0])
 
     @property
+    def is_triangles(self) -> bool:
+        """True when halfedge h is side h mod 3 of triangle h // 3."""
+        return self.next_of is None
+
+    @property
+    def F(self) -> np.ndarray:
+        """(nf, 3) the vertex at each corner of each triangle (a view of `vertex`)."""
+        if not self.is_triangles:
+            raise ShapeError("F (nf, 3) exists for triangles only; this cell decomposition has polygons")
+        return self.vertex.reshape(-1, 3)
+
+    @cached_property
+    def face(self) -> np.ndarray:
+        return np.arange(self.vertex.size) // 3 if self.face_of is None else self.face_of
+
+    @cached_property
+    def next(self) -> np.ndarray:
+        return next_halfedge(np.arange(self.vertex.size)) if self.next_of is None else self.next_of
+
+    @cached_property
+    def prev(self) -> np.ndarray:
+        prev = np.empty_like(self.next)
+        prev[self.next] = np.arange(self.next.size)
+        return prev
+
+    @cached_property
     def head(self) -> np.ndarray:
         """The vertex each halfedge ends at."""
         return self.vertex[self.next]
+
+    @cached_property
+    def twin(self) -> np.ndarray:
+        """(nh,) the other halfedge of the same edge, -1 on a boundary edge."""
+        return _twins(self.halfedges, self.vertex.size)
+
+    @cached_property
+    def sign(self) -> np.ndarray:
+        """(nh,) +1 where h runs along its edge's canonical direction, -1 against it."""
+        if self.sign_of is not None:
+            return self.sign_of
+        sign = np.ones(self.vertex.size, dtype=np.int64)
+        second = self.halfedges[:, 1]
+        sign[second[second >= 0]] = -1
+        return sign
+
+    @cached_property
+    def edges(self) -> np.ndarray:
+        """(ne, 2) the endpoints of each edge in its canonical direction (loops and repeated
+        pairs possible)."""
+        if self.edge_ends is not None:
+            return self.edge_ends
+        h = self.halfedges[:, 0]
+        return np.stack([self.vertex[h], self.vertex[self.next[h]]], axis=1)
+
+    @cached_property
+    def boundary_vertex_mask(self) -> np.ndarray:
+        """(n_vertices,) bool: the vertex lies on a boundary edge."""
+        h = self.halfedges[self.halfedges[:, 1] < 0, 0]
+        mask = np.zeros(self.n_vertices, dtype=bool)
+        mask[self.vertex[h]] = True
+        mask[self.vertex[self.next[h]]] = True
+        return mask
+
+
+def _twins(halfedges: np.ndarray, n_halfedges: int) -> np.ndarray:
+    twin = np.full(n_halfedges, -1, dtype=np.int64)
+    h, t = halfedges[:, 0], halfedges[:, 1]
+    glued = t >= 0
+    twin[h[glued]] = t[glued]
+    twin[t[glued]] = h[glued]
+    return twin
 
 
 def faces_as_corners(F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -105,37 +203,58 @@ def _face_of(sizes: np.ndarray, corner: int) -> int:
     return int(np.searchsorted(np.cumsum(sizes), corner, side="right"))
 
 
-def _inverse_permutation(p: np.ndarray) -> np.ndarray:
-    inv = np.empty_like(p)
-    inv[p] = np.arange(p.size)
-    return inv
+def glue_by_keys(keys: np.ndarray):
+    """Group halfedges with equal keys into edges, with one sort.
+
+    Returns `(edge, halfedges, unique_keys, count)`: the edge of each halfedge, numbered in
+    increasing key order (for keys lo · nv + hi the lexicographic order of vertex pairs); the
+    (ne, 2) halfedges of each edge, lowest index first (-1 in column 1 where there is one; only
+    the first two are kept); the sorted distinct keys and their multiplicities.
+    """
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    n = keys.size
+    if n % 2 == 0 and n and np.array_equal(sorted_keys[0::2], sorted_keys[1::2]) and np.all(sorted_keys[2::2] != sorted_keys[1:-1:2]):
+        # every key exactly twice (a closed surface): the pairs are consecutive
+        edge = np.empty(n, dtype=np.int64)
+        edge[order] = np.arange(n) >> 1
+        return edge, order.reshape(-1, 2), sorted_keys[0::2], np.full(n // 2, 2)
+    is_start = np.empty(keys.size, dtype=bool)
+    is_start[:1] = True
+    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=is_start[1:])
+    starts = np.flatnonzero(is_start)
+    count = np.diff(np.append(starts, keys.size))
+    edge = np.empty(keys.size, dtype=np.int64)
+    edge[order] = np.cumsum(is_start) - 1
+    halfedges = np.full((starts.size, 2), -1, dtype=np.int64)
+    halfedges[:, 0] = order[starts]
+    two = count >= 2
+    halfedges[:, 1][two] = order[starts[two] + 1]  # column view: row-wise masks are slow
+    return edge, halfedges, sorted_keys[starts], count
 
 
-def _twins(edge: np.ndarray, n_edges: int) -> np.ndarray:
-    """Pair the (at most two) halfedges of each edge; -1 where an edge has one halfedge."""
-    order = np.argsort(edge, kind="stable")
-    count = np.bincount(edge, minlength=n_edges)
-    start = np.concatenate([[0], np.cumsum(count)[:-1]])
-    twin = np.full(edge.size, -1, dtype=np.int64)
-    pair = start[count == 2]
-    twin[order[pair]] = order[pair + 1]
-    twin[order[pair + 1]] = order[pair]
-    return twin
+def _glue_by_vertices(tail, head, nv: int, face):
+    """`(edge, halfedges, keys)` of halfedges glued where they join the same two vertex labels
+    (keys lo · nv + hi); `face` (a callable h -> face) names the faces of an edge in more than two.
 
-
-def _check_multiplicity(edge, face, edges, n_edges) -> None:
-    count = np.bincount(edge, minlength=n_edges)
+    **Raises:** `NonManifoldError` for an edge in more than two faces.
+    """
+    keys = np.minimum(tail, head)
+    keys *= np.int64(nv)
+    keys += np.maximum(tail, head)
+    edge, halfedges, keys, count = glue_by_keys(keys)
     bad = np.flatnonzero(count > 2)
     if bad.size:
         e = int(bad[0])
-        faces = sorted(set(face[edge == e].tolist()))
+        faces = sorted(set(face(np.flatnonzero(edge == e)).tolist()))
         raise NonManifoldError(
-            f"edge {e} with vertices ({edges[e, 0]}, {edges[e, 1]}) lies in {count[e]} faces {faces}; "
+            f"edge {e} with vertices ({keys[e] // nv}, {keys[e] % nv}) lies in {count[e]} faces {faces}; "
             "a surface edge lies in at most two"
         )
+    return edge, halfedges, keys
 
 
-def _corner_identification(h_next, edge, sign, twin, n_corners) -> tuple[int, np.ndarray]:
+def _corner_identification(h_next, sign, twin, n_corners) -> tuple[int, np.ndarray]:
     """Classes of corners identified across glued edges: `(n_classes, label per corner)`.
 
     Across an edge with halfedges h1, h2: tails match tails when they run the same way
@@ -150,10 +269,10 @@ def _corner_identification(h_next, edge, sign, twin, n_corners) -> tuple[int, np
     return connected_components(graph, directed=False)
 
 
-def _check_vertex_fans(vertex, h_next, edge, sign, twin) -> None:
+def _check_vertex_fans(h: Halfedges) -> None:
     """Each vertex must carry exactly one fan of corners (its neighbourhood is a disk)."""
-    n, labels = _corner_identification(h_next, edge, sign, twin, vertex.size)
-    pairs = np.unique(np.stack([vertex, labels], axis=1), axis=0)
+    _, labels = _corner_identification(h.next, h.sign, h.twin, h.vertex.size)
+    pairs = np.unique(np.stack([h.vertex, labels], axis=1), axis=0)
     fans = np.bincount(pairs[:, 0])
     bad = np.flatnonzero(fans > 1)
     if bad.size:
@@ -173,7 +292,9 @@ def _check_repeated_vertices(vertex, face) -> None:
 
 
 def from_faces(F, n_vertices: int | None = None) -> Halfedges:
-    """Halfedges of a surface given by faces of vertex indices; vectorised (sort / unique).
+    """Halfedges of a surface given by faces of vertex labels; vectorised (one sort of the
+    halfedges by vertex pair).  Edges are numbered in lexicographic order of their vertex pairs
+    (i, j), i < j, which is also their canonical direction.
 
     **Arguments:** `F`, (nf, k) int array or list of polygons; `n_vertices`, the number of vertex
     labels (default `max(F) + 1`).
@@ -189,16 +310,67 @@ def from_faces(F, n_vertices: int | None = None) -> Halfedges:
         raise MeshError(f"face {face[bad]} has the vertex index {vertex[bad]} >= n_vertices = {nv}")
     _check_repeated_vertices(vertex, face)
     head = vertex[h_next]
-    lo, hi = np.minimum(vertex, head), np.maximum(vertex, head)
-    edges_, edge = np.unique(np.stack([lo, hi], axis=1), axis=0, return_inverse=True)
-    edge = edge.reshape(-1)
-    sign = np.where(vertex < head, 1, -1)
-    _check_multiplicity(edge, face, edges_, edges_.shape[0])
-    twin = _twins(edge, edges_.shape[0])
-    _check_vertex_fans(vertex, h_next, edge, sign, twin)
+    edge, halfedges, keys = _glue_by_vertices(vertex, head, nv, lambda h: face[h])
     n_faces = int(face.max()) + 1 if face.size else 0
-    return Halfedges(vertex, face, h_next, _inverse_permutation(h_next), edge, sign, twin,
-                     edges_, nv, n_faces)
+    ends = np.stack([keys // nv, keys % nv], axis=1) if nv else np.zeros((0, 2), np.int64)
+    h = Halfedges(vertex, edge, halfedges, nv, n_faces, face_of=face, next_of=h_next,
+                  sign_of=np.where(vertex < head, 1, -1), edge_ends=ends)
+    _check_vertex_fans(h)
+    return h
+
+
+def checked_triangles(F, n_vertices: int | None = None) -> tuple[np.ndarray, int]:
+    """`(F, nv)`: F as an (nf, 3) int64 array of labels < nv (default max + 1), no face repeating
+    a vertex.  **Raises:** `ShapeError` (not (nf, 3)) or `MeshError` (a non-integer, negative or
+    too large index, a repeated vertex), naming the face."""
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ShapeError(f"F must be an (nf, 3) array of triangles, got shape {F.shape}")
+    if F.size and not np.issubdtype(F.dtype, np.integer) and not np.all(F == np.round(F)):
+        f = int(np.argwhere(F != np.round(F))[0, 0])
+        raise MeshError(f"face {f} has a non-integer vertex index {F[f].tolist()}")
+    F = F.astype(np.int64)
+    if F.size and F.min() < 0:
+        raise MeshError(f"face {int(np.argwhere(F < 0)[0, 0])} has a negative vertex index")
+    repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+    if repeated.any():
+        f = int(np.argmax(repeated))
+        raise MeshError(f"face {f} repeats a vertex: {F[f].tolist()}")
+    nv = int(F.max()) + 1 if n_vertices is None else int(n_vertices)
+    if F.size and F.max() >= nv:
+        raise MeshError(f"face {int(np.argwhere(F >= nv)[0, 0])} has a vertex index >= n_vertices = {nv}")
+    return F, nv
+
+
+def glue_triangles(F: np.ndarray, nv: int) -> tuple[Halfedges, np.ndarray]:
+    """`(Halfedges, keys)` of consistently oriented triangles F (already `checked_triangles`),
+    halfedge h = 3 f + i; keys (ne,) = i · nv + j, i < j, the vertex pair of each edge (edges
+    numbered in their lexicographic order).  No fan check: the fast path of the intrinsic
+    triangulations.
+
+    **Raises:** `NonManifoldError` for an edge in more than two faces; `OrientationError` for
+    two faces traversing an edge in the same direction (naming the edge's vertices).
+    """
+    tail = F.reshape(-1)
+    head = np.empty_like(F)
+    head[:, :2] = F[:, 1:]
+    head[:, 2] = F[:, 0]
+    edge, halfedges, keys = _glue_by_vertices(tail, head.reshape(-1), nv, lambda h: h // 3)
+    h, t = halfedges[:, 0], halfedges[:, 1]  # column views (row gathers are slow)
+    same = (t >= 0) & (tail[h] == tail[t])
+    if same.any():
+        e = int(np.argmax(same))
+        raise OrientationError(
+            f"edge {e} with vertices ({keys[e] // nv}, {keys[e] % nv}) is traversed in the same "
+            "direction by its two faces; orient the faces consistently (ddgjax.mesh.orient)"
+        )
+    return Halfedges(tail, edge, halfedges, nv, F.shape[0]), keys
+
+
+def _inverse_permutation(p: np.ndarray) -> np.ndarray:
+    inv = np.empty_like(p)
+    inv[p] = np.arange(p.size)
+    return inv
 
 
 def from_gluing(face, h_next, edge, sign) -> Halfedges:
@@ -211,21 +383,56 @@ def from_gluing(face, h_next, edge, sign) -> Halfedges:
     **Raises:** `NonManifoldError` for a label used more than twice.
     """
     face, h_next, edge, sign = (np.asarray(a, dtype=np.int64) for a in (face, h_next, edge, sign))
-    n_edges = int(edge.max()) + 1
-    count = np.bincount(edge, minlength=n_edges)
+    edge, halfedges, _, count = glue_by_keys(edge)
     if np.any(count > 2):
         e = int(np.argmax(count > 2))
         raise NonManifoldError(f"edge label {e} is used {count[e]} times; a surface edge lies on at most two sides")
-    twin = _twins(edge, n_edges)
-    _, vertex = _corner_identification(h_next, edge, sign, twin, edge.size)
-    head = vertex[h_next]
-    order = np.argsort(edge, kind="stable")
-    first = order[np.concatenate([[0], np.cumsum(count)[:-1]])]
-    tail0 = np.where(sign[first] > 0, vertex[first], head[first])
-    head0 = np.where(sign[first] > 0, head[first], vertex[first])
-    edges_ = np.stack([tail0, head0], axis=1)
-    return Halfedges(vertex.astype(np.int64), face, h_next, _inverse_permutation(h_next), edge, sign,
-                     twin, edges_, int(vertex.max()) + 1, int(face.max()) + 1)
+    _, vertex = _corner_identification(h_next, sign, _twins(halfedges, edge.size), edge.size)
+    first = halfedges[:, 0]
+    tail, head = vertex[first], vertex[h_next[first]]
+    ends = np.stack([np.where(sign[first] > 0, tail, head), np.where(sign[first] > 0, head, tail)], axis=1)
+    return Halfedges(vertex.astype(np.int64), edge, halfedges, int(vertex.max()) + 1, int(face.max()) + 1,
+                     face_of=face, next_of=h_next, sign_of=sign, edge_ends=ends)
+
+
+def _check_twins(twin: np.ndarray) -> None:
+    n = twin.size
+    if n % 3:
+        raise ShapeError(f"twin must have 3 entries per triangle, got {n}")
+    bad = np.flatnonzero((twin < -1) | (twin >= n))
+    if bad.size:
+        raise GluingError(f"halfedge {bad[0]} is glued to {twin[bad[0]]}, outside 0..{n - 1}")
+    bad = np.flatnonzero(twin == np.arange(n))
+    if bad.size:
+        raise GluingError(f"halfedge {bad[0]} (side {bad[0] % 3} of face {bad[0] // 3}) is glued to itself")
+    glued = np.flatnonzero(twin >= 0)
+    bad = glued[twin[twin[glued]] != glued]
+    if bad.size:
+        h = int(bad[0])
+        raise GluingError(
+            f"halfedge {h} (side {h % 3} of face {h // 3}) is glued to {twin[h]}, which is glued to "
+            f"{twin[twin[h]]}; a gluing must pair sides"
+        )
+
+
+def from_twins(twin) -> Halfedges:
+    """Triangles glued along sides, reversing direction: halfedge h (side h mod 3 of face h // 3)
+    is glued to `twin[h]` (-1: boundary).  Vertices are the classes of corners the gluing
+    identifies; a face may be glued to itself, loops and multiple edges are allowed.  Edges are
+    numbered in order of their first halfedge.
+
+    **Raises:** `ShapeError` unless there are 3 sides per face; `GluingError` for an index out of
+    range, a side glued to itself or a gluing that is not an involution (naming the halfedge).
+    """
+    twin = np.asarray(twin, dtype=np.int64).reshape(-1)
+    _check_twins(twin)
+    h = np.arange(twin.size)
+    first = np.where(twin >= 0, np.minimum(h, twin), h)
+    owners, edge = np.unique(first, return_inverse=True)
+    halfedges = np.stack([owners, np.where(twin[owners] >= 0, twin[owners], -1)], axis=1)
+    sign = np.where(h == owners[edge], 1, -1)
+    n_vertices, vertex = _corner_identification(next_halfedge(h), sign, twin, h.size)
+    return Halfedges(vertex.astype(np.int64), edge.reshape(-1), halfedges, int(n_vertices), twin.size // 3)
 
 
 def as_halfedges(F) -> Halfedges:
@@ -248,3 +455,37 @@ def edges(F) -> np.ndarray:
     `edge_lengths`).
     """
     return as_halfedges(F).edges
+
+
+def boundary_indices(boundary, n_vertices: int) -> np.ndarray:
+    """The vertex set V₀ (e.g. the fixed boundary of a Dirichlet problem) as int64 indices, in
+    the given order (a mask: increasing); `boundary` is an index array or a bool mask of length
+    n_vertices.
+
+    **Raises:** `InvalidInputError` naming an index outside 0..n_vertices−1 or a repeated index,
+    `ShapeError` for a mask of the wrong length or non-integer indices.
+    """
+    b = np.array(boundary)
+    if b.dtype == bool:
+        if b.shape != (n_vertices,):
+            raise ShapeError(f"a boundary mask needs shape ({n_vertices},), got {b.shape}")
+        return np.flatnonzero(b).astype(np.int64)
+    b = b.reshape(-1)
+    if b.size and not np.issubdtype(b.dtype, np.integer):
+        raise ShapeError(f"boundary must be vertex indices (integers) or a bool mask, got dtype {b.dtype}")
+    out = np.flatnonzero((b < 0) | (b >= n_vertices))
+    if out.size:
+        raise InvalidInputError(
+            f"boundary vertex {b[out[0]]} (entry {out[0]}) does not exist: vertices are 0..{n_vertices - 1}"
+        )
+    unique, counts = np.unique(b, return_counts=True)
+    if np.any(counts > 1):
+        raise InvalidInputError(f"boundary vertex {unique[counts > 1][0]} is listed more than once")
+    return b.astype(np.int64)
+
+
+def boundary_vertices(F, n_vertices: int | None = None) -> np.ndarray:
+    """Sorted indices of the vertices on boundary edges of F (faces or `Halfedges`): the default
+    fixed set of the Dirichlet and Plateau problems."""
+    h = F if isinstance(F, Halfedges) else from_faces(F, n_vertices=n_vertices)
+    return np.flatnonzero(h.boundary_vertex_mask)

@@ -18,6 +18,8 @@ import numpy as np
 from .._checks import is_concrete
 from ..errors import MeshError, OrientationError, ShapeError
 from .connectivity import Halfedges, faces_as_corners, from_faces
+from .lengths import corner_angles as angles_from_sides
+from .lengths import defect_from_angles, squared_side_lengths
 
 __all__ = [
     "corner_angles",
@@ -60,13 +62,9 @@ def _validate(V, F):
     return h
 
 
-def boundary_vertex_mask(h) -> np.ndarray:
-    """Bool (n_vertices,): the vertex lies on a boundary edge (numpy, from `Halfedges`)."""
-    mask = np.zeros(h.n_vertices, dtype=bool)
-    lonely = h.twin < 0
-    mask[h.vertex[lonely]] = True
-    mask[h.head[lonely]] = True
-    return mask
+def boundary_vertex_mask(h: Halfedges) -> np.ndarray:
+    """Bool (n_vertices,): the vertex lies on a boundary edge (`Halfedges.boundary_vertex_mask`)."""
+    return h.boundary_vertex_mask
 
 
 def _angle_between(u, w):
@@ -74,20 +72,31 @@ def _angle_between(u, w):
     return jnp.arctan2(jnp.linalg.norm(jnp.cross(u, w), axis=-1), jnp.sum(u * w, axis=-1))
 
 
-@jax.jit
-def _angles_at_corners(V, vertex, nxt, prv):
+def _is_triangle_array(F) -> bool:
+    return hasattr(F, "shape") and len(F.shape) == 2 and F.shape[1] == 3
+
+
+@partial(jax.jit, static_argnames="triangles")
+def _angles_at_corners(V, vertex, nxt, prv, triangles: bool):
+    """Flat corner angles.  `triangles` (corners of an (nf, 3) array): from the side lengths
+    alone (`lengths.corner_angles`, Thm 5.5); polygons, whose angles the side lengths do not
+    determine: ∠(v_next − v, v_prev − v)."""
+    if triangles:
+        L = jnp.sqrt(squared_side_lengths(V[vertex.reshape(-1, 3)]))
+        return angles_from_sides(L).reshape(-1)
     P = V[vertex]
     return _angle_between(P[nxt] - P, P[prv] - P)
 
 
 def corner_angles(V, F):
-    """Interior angle α at every corner of every (convex) face: α = ∠(v_next − v, v_prev − v).
+    """Interior angle α at every corner of every (convex) face: for triangles from the side
+    lengths |v_j − v_i| (`lengths.corner_angles`), for polygons α = ∠(v_next − v, v_prev − v).
 
     **Returns:** (nf, k) for an (nf, k) array `F`, else (n_corners,) in the order of the faces.
     **Raises:** as `angle_defect`.
     """
     _validate(V, F)
-    angles = _angles_at_corners(jnp.asarray(V), *_corners(F))
+    angles = _angles_at_corners(jnp.asarray(V), *_corners(F), triangles=_is_triangle_array(F))
     return angles.reshape(jnp.shape(F)) if hasattr(F, "shape") else angles
 
 
@@ -103,15 +112,6 @@ def _boundary_vertices(vertex, nxt, nv):
     return jnp.maximum(jax.ops.segment_max(lonely, vertex, nv), jax.ops.segment_max(lonely, head, nv)) > 0
 
 
-@jax.jit
-def defect_from_angles(angles, vertex, boundary):
-    """K(p) = 2π − Σ α at interior vertices (Def 5.2), φ(p) = π − Σ α at boundary vertices
-    (Remark 5.4), from the flat corner angles, their vertices and the (nv,) boundary mask.
-    """
-    total = jax.ops.segment_sum(angles, vertex, boundary.shape[0])
-    return jnp.where(boundary, jnp.pi, 2 * jnp.pi) - total
-
-
 def angle_defect(V, F):
     """Discrete Gaussian curvature per vertex, (nv,) (Def 5.2, Remark 5.4):
 
@@ -125,13 +125,13 @@ def angle_defect(V, F):
     h = _validate(V, F)
     vertex, nxt, prv = _corners(F)
     nv = jnp.shape(V)[0]
-    boundary = _boundary_vertices(vertex, nxt, nv) if h is None else boundary_vertex_mask(h)
-    return _angle_defect_kernel(jnp.asarray(V), vertex, nxt, prv, boundary)
+    boundary = _boundary_vertices(vertex, nxt, nv) if h is None else h.boundary_vertex_mask
+    return _angle_defect_kernel(jnp.asarray(V), vertex, nxt, prv, boundary, triangles=_is_triangle_array(F))
 
 
-@jax.jit
-def _angle_defect_kernel(V, vertex, nxt, prv, boundary):
-    return defect_from_angles(_angles_at_corners(V, vertex, nxt, prv), vertex, boundary)
+@partial(jax.jit, static_argnames="triangles")
+def _angle_defect_kernel(V, vertex, nxt, prv, boundary, triangles: bool):
+    return defect_from_angles(_angles_at_corners(V, vertex, nxt, prv, triangles), vertex, boundary)
 
 
 def vertex_kind(V, F, atol: float = 1e-12):
@@ -169,9 +169,7 @@ def _interior_pairs(F, nv):
     `F` may already be `Halfedges`.
     """
     h = F if isinstance(F, Halfedges) else from_faces(np.asarray(F) if hasattr(F, "shape") else F, n_vertices=nv)
-    order = np.argsort(h.edge, kind="stable")
-    first = order[np.concatenate([[0], np.flatnonzero(np.diff(h.edge[order])) + 1])]
-    h2 = h.twin[first]
+    first, h2 = h.halfedges[:, 0], h.halfedges[:, 1]
     inner = h2 >= 0
     same = inner & (h.sign[first] == h.sign[np.where(inner, h2, first)])
     if np.any(same):

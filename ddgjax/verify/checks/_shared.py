@@ -7,7 +7,7 @@ import functools
 
 import numpy as np
 
-from ddgjax import elastica_exact as exact
+from ddgjax.smooth import elastica as exact
 
 # A clamped space elastica with a genuinely three-dimensional load (Thm 3.8, Thm 3.10, Cor 3.9).
 SPACE_CHORD, SPACE_START, SPACE_END = (0.5, 0.3, 0.2), (0.0, 1.0, 0.3), (0.2, -1.0, 0.5)
@@ -65,10 +65,11 @@ def thm_3_8_spread(T, gamma, a) -> float:
     return float(np.max(np.abs(b - b[0])))
 
 
-def euclidean_motion_residual(points, velocities, extra=None) -> float:
-    """`min over (a, b[, c]) of max_k |v_k − (a × p_k + b [+ c e_k])|` by least squares: how far
-    a velocity field is from an infinitesimal Euclidean motion (Cor 3.7), optionally plus a
-    multiple c of another field `extra` (Def 3.7)."""
+def euclidean_motion_fit(points, velocities, extra=None) -> tuple[float, np.ndarray]:
+    """`(residual, (a, b[, c]))`: the least-squares fit of `v_k ≈ a × p_k + b [+ c e_k]` and its
+    residual `max_k |v_k − (a × p_k + b [+ c e_k])|`: how far a velocity field is from an
+    infinitesimal Euclidean motion (Cor 3.7), optionally plus a multiple c of another field
+    `extra` (Def 3.7)."""
     points, velocities = np.asarray(points), np.asarray(velocities)
     rows = np.cross(points[:, None, :], np.eye(3)[None]).transpose(0, 2, 1)  # [p]× e_j = p × e_j
     blocks = [-rows, np.broadcast_to(np.eye(3), rows.shape)]
@@ -76,7 +77,12 @@ def euclidean_motion_residual(points, velocities, extra=None) -> float:
         blocks.append(-np.asarray(extra)[:, :, None])
     A = np.concatenate(blocks, axis=2).reshape(-1, sum(b.shape[2] for b in blocks))
     solution = np.linalg.lstsq(A, velocities.ravel(), rcond=None)[0]
-    return float(np.max(np.abs(A @ solution - velocities.ravel())))
+    return float(np.max(np.abs(A @ solution - velocities.ravel()))), solution
+
+
+def euclidean_motion_residual(points, velocities, extra=None) -> float:
+    """The residual of `euclidean_motion_fit`."""
+    return euclidean_motion_fit(points, velocities, extra)[0]
 
 
 def unit_rows(X) -> np.ndarray:

@@ -41,25 +41,29 @@ def random_polygon(n: int, seed: int = 0) -> np.ndarray:
     return np.asarray(curves.from_tangents(steps))
 
 
-@check("Def 1.4", "the vertex curvature of three points on a circle of radius R is 1/R, at any spacing",
-       quantity="max_k |κ_k − 1/R| (tilted circle, random points)", at_most=1e-12, quick=dict(points=12))
+@check("Def 1.4", "the vertex curvature of three points on a circle of radius R is ±1/R at any spacing (+ counter-clockwise)",
+       quantity="max_k |κ_k ∓ 1/R| (planar both ways, tilted circle; random points)", at_most=1e-12, quick=dict(points=12))
 def vertex_curvature_of_circle(ctx, points):
     R, rng = 1.7, np.random.default_rng(1)
     angles = np.sort(rng.uniform(0.0, 5.0, size=points))
+    planar = R * np.stack([np.cos(angles), np.sin(angles)], axis=1)
     Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    gamma = R * np.stack([np.cos(angles), np.sin(angles), np.zeros(points)], axis=1) @ Q.T
-    return float(np.max(np.abs(np.asarray(curves.curvature(gamma, "vertex")) - 1 / R)))
+    tilted = np.column_stack([planar, np.zeros(points)]) @ Q.T
+    signed = ((planar, 1 / R), (tilted, 1 / R), (planar[::-1], -1 / R))  # clockwise: negative in the plane
+    return max(float(np.max(np.abs(np.asarray(curves.curvature(gamma, "vertex")) - k))) for gamma, k in signed)
 
 
-@check("Def 1.5, 1.6", "the edge and arc-length curvatures of a regular n-gon are 1/(R cos(π/n)), its inscribed circle",
-       quantity="max |κ − 1/(R cos(π/n))| over both kinds", at_most=1e-12, quick=dict(n=12))
+@check("Def 1.5, 1.6", "the regular n-gon's edge and arc-length curvatures are 1/(R cos(π/n)) (inscribed circle), its vertex curvature 1/R",
+       quantity="max |κ − exact| over the three kinds and n = 5, n", at_most=1e-12, quick=dict(n=12))
 def polygon_curvatures(ctx, n):
-    R = 2.5
-    angles = 2 * np.pi * np.arange(n) / n
-    gamma = R * np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    inscribed = 1 / (R * np.cos(np.pi / n))
-    return max(float(np.max(np.abs(np.asarray(curves.curvature(gamma, kind, closed=True)) - inscribed)))
-               for kind in ("edge", "arclength"))
+    R, worst = 2.5, 0.0
+    for m in (5, n):
+        angles = 2 * np.pi * np.arange(m) / m
+        gamma = R * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+        exact = {"vertex": 1 / R, "edge": 1 / (R * np.cos(np.pi / m)), "arclength": 1 / (R * np.cos(np.pi / m))}
+        worst = max([worst] + [float(np.max(np.abs(np.asarray(curves.curvature(gamma, kind, closed=True)) - k)))
+                               for kind, k in exact.items()])
+    return worst
 
 
 @check("Remark 2.1", "the vertex tangent has length 1/cos(φ_k/2) and the direction of T_k + T_{k−1}",

@@ -136,6 +136,6 @@ def _frame_equation_defect(s):
 def lagrange_top_conservation(ctx, t1, steps):
     alpha, a = 2.5, np.array([0.0, 0.0, -1.0])
     Phi0 = qt.from_axis_angle(np.array([1.0, 1.0, 0.0]), 0.9)
-    _, states = dg.top.simulate(Phi0, np.array([3.0, 0.4, -0.2]), t1, alpha=alpha, a=a, steps=steps)
-    c = dg.top.conserved_quantities(states, alpha=alpha, a=a)
+    _, states = dg.smooth.top.simulate(Phi0, np.array([3.0, 0.4, -0.2]), t1, alpha=alpha, a=a, steps=steps)
+    c = dg.smooth.top.conserved_quantities(states, alpha=alpha, a=a)
     return max(float(jnp.max(jnp.abs(c[k] - c[k][0]))) for k in ("energy", "axial_momentum"))

@@ -21,7 +21,7 @@ def gauss_bonnet_builtin(ctx):
         V, F = getattr(mesh, name)()
         worst = max(worst, abs(float(jnp.sum(mesh.angle_defect(V, F))) - 2 * np.pi * mesh.euler_characteristic(F)))
     for name in ("icosphere", "torus"):
-        dg.plot_surface.surface(*getattr(mesh, name)(), path=ctx.figure(f"angle_defect_{name}.png"),
+        dg.plot.surface.surface(*getattr(mesh, name)(), path=ctx.figure(f"angle_defect_{name}.png"),
                                 title=f"angle defect K(p), {name}")
     return worst
 

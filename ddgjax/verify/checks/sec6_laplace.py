@@ -7,9 +7,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 import ddgjax as dg
-from ddgjax import plot_laplace
 from ddgjax.errors import NonUniqueSolutionError
-from ddgjax.verify import check
+from ddgjax.plot import laplace as plot_laplace
+from ddgjax.verify import check, references
 from energies import area, dirichlet
 
 from ._surfaces import random_graph
@@ -199,15 +199,15 @@ def catenoid_is_critical(ctx, n):
         return float("inf")
     problem = area.simplicial(V, F)
     gradient = np.asarray(jax.jit(jax.grad(problem.energy))(V, None))
-    return float(np.max(np.abs(gradient[_interior(len(V), area.mesh_boundary(F, len(V)))])))
+    return float(np.max(np.abs(gradient[_interior(len(V), dg.mesh.boundary_vertices(F, len(V)))])))
 
 
 @check("Fig 6.5", "the neck radius of the simplicial catenoid converges to the smooth catenoid's c (c cosh(H/c) = R), O(h²)",
        quantity="fitted order of |min r − c|", target=2.0, within=0.3, quick=dict(ns=(4, 6, 8, 12)),
        full=dict(ns=(8, 12, 16, 24, 32)))
 def catenoid_neck_order(ctx, ns):
-    c = area.catenoid_neck()
-    table = dg.limits.convergence(lambda n: abs(area.neck_radius(_catenoid(n)[0]) - c), ns, label="neck radius error")
+    c = references.catenoid_neck()
+    table = dg.limits.convergence(lambda n: abs(references.neck_radius(_catenoid(n)[0]) - c), ns, label="neck radius error")
     return ctx.convergence(table, "convergence_catenoid_neck", title="Fig 6.5: catenoid neck radius").fitted_order
 
 
@@ -216,7 +216,7 @@ def catenoid_neck_order(ctx, ns):
 def catenoid_newton_polish(ctx, n):
     V1, F, _ = area.minimal_surface(*dg.mesh.builtin.cylinder(n), tol=1e-6)
     V2, _, info = area.minimal_surface(V1, F, method="newton", tol=1e-11)
-    inner = _interior(len(V2), area.mesh_boundary(F, len(V2)))
+    inner = _interior(len(V2), dg.mesh.boundary_vertices(F, len(V2)))
     residual = float(np.max(np.abs((dg.laplace.cotan_laplacian(V2, F) @ V2)[inner])))
     return residual if info["iterations"] <= 5 else float("inf")
 
@@ -241,7 +241,7 @@ def _fig_6_6():
        quantity="|∇A| at the centre vertex", at_most=1e-12, quick=dict())
 def negative_weights_star_is_critical(ctx):
     V, F = _fig_6_6()
-    dg.plot_surface.surface(V, F, ctx.figure("fig_6_6_star.png"), title="Fig 6.6: minimal, outside the convex hull")
+    dg.plot.surface.surface(V, F, ctx.figure("fig_6_6_star.png"), title="Fig 6.6: minimal, outside the convex hull")
     return float(np.max(np.abs((dg.laplace.cotan_laplacian(V, F) @ V)[0])))
 
 

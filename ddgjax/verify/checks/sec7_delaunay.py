@@ -11,11 +11,10 @@ import scipy.sparse as sp
 
 import ddgjax as dg
 from ddgjax import intrinsic
-from ddgjax.intrinsic import minimal, rippa
-from ddgjax.intrinsic import plot as iplot
+from ddgjax.intrinsic import rippa
 from ddgjax.intrinsic import triangulation as T
-from ddgjax.intrinsic.minimal import interior_residual
-from ddgjax.verify import check
+from ddgjax.verify import check, figures
+from energies.area import interior_residual
 
 
 def _planar_skinny(n_inner: int = 150):
@@ -102,7 +101,7 @@ def harmonic_index_decreases(ctx, level):
        full=dict(n_inner=300))
 def flip_figure(ctx, n_inner):
     V, F, _ = _planar_skinny(n_inner)
-    result = intrinsic.plot.before_after(V, F, ctx.figure("intrinsic_delaunay_flips.png"))
+    result = dg.plot.intrinsic.before_after(V, F, ctx.figure("intrinsic_delaunay_flips.png"))
     return float(np.sum(~intrinsic.delaunay_edges(result.triangulation))) if result.n_flips else float("inf")
 
 
@@ -279,7 +278,7 @@ def laplace_beltrami_isometry_invariant(ctx):
     return float(abs(L - L_pushed).max() / abs(L).max()) if np.linalg.norm(pushed[0] - V[0]) > 0.1 else float("inf")
 
 
-_fig_7_26 = functools.cache(minimal.fig_7_26)
+_fig_7_26 = functools.cache(figures.fig_7_26)
 FIG_7_26 = dict(quick=dict(seed=0, budget=30), full=dict(seed=1, budget=200))  # the sizes of the Fig 7.26 checks
 
 
@@ -299,7 +298,7 @@ def narrow_minimal_surface_converges(ctx, seed, budget):
     fixed = np.zeros(len(W), dtype=bool)
     fixed[boundary] = True
     residual = interior_residual(intrinsic.cotan_laplacian(tri), W, fixed)
-    iplot.draw_fig_7_26(ctx.figure("fig_7_26.png"), V, F, cotan, (W, F1, info))
+    figures.draw_fig_7_26(ctx.figure("fig_7_26.png"), V, F, cotan, (W, F1, info))
     polygon = 0.5 * 32 * np.sin(2 * np.pi / 32)
     ok = info["converged"] and intrinsic.is_delaunay(tri) and info["flips"].sum() > 0
     return residual + abs(info["area"][-1] - polygon) / polygon if ok else float("inf")

@@ -56,30 +56,36 @@ def naive_chain_does_not_commute(ctx, N):
     return _bracket_with_tangent_flow("naive", N)
 
 
-@check("Appendix A", "Gauss6 integration keeps H, the total spin and |S_i| = 1 (integrable chain)",
-       quantity="max drift of H, Σ S_i and |S_i|", at_most=1e-9, quick=dict(N=32, t1=5.0, steps=500),
+@check("Appendix A", "Gauss6 integration keeps H, the total spin and |S_i| = 1 (naive and integrable chains)",
+       quantity="max drift of H, Σ S_i and |S_i| over both chains", at_most=1e-9, quick=dict(N=32, t1=5.0, steps=500),
        full=dict(N=64, t1=20.0, steps=4000))
 def spin_chain_conservation(ctx, N, t1, steps):
-    S0 = random_spins(N, 2)
-    H = heisenberg.hamiltonian("integrable", 1.0)
-    _, Ss = dg.integrate(heisenberg.flow("integrable", 1.0), S0, t1, steps=steps)
-    dg.plot.spin_chain(Ss[-1], path=ctx.figure("spin_chain.png"), title=f"integrable chain, t = {t1:g}")
-    energies = jax.vmap(H)(Ss)
-    return float(max(jnp.max(jnp.abs(energies - energies[0])), jnp.max(jnp.abs(Ss.sum(axis=1) - S0.sum(axis=0))),
-                     jnp.max(jnp.abs(jnp.linalg.norm(Ss, axis=-1) - 1))))
+    S0, drift = random_spins(N, 2), 0.0
+    for kind in ("naive", "integrable"):
+        H = heisenberg.hamiltonian(kind, 1.0)
+        _, Ss = dg.integrate(heisenberg.flow(kind, 1.0), S0, t1, steps=steps)
+        if kind == "integrable":
+            dg.plot.spin_chain(Ss[-1], path=ctx.figure("spin_chain.png"), title=f"integrable chain, t = {t1:g}")
+        energies = jax.vmap(H)(Ss)
+        drift = max(drift, float(jnp.max(jnp.abs(energies - energies[0]))), float(jnp.max(jnp.abs(Ss.sum(axis=1) - S0.sum(axis=0)))),
+                    float(jnp.max(jnp.abs(jnp.linalg.norm(Ss, axis=-1) - 1))))
+    return drift
 
 
 @check("eq (A.3)", "the flow of H/ε (time scaled by 1/ε) tends to ∂_t S = J S × S'' on a spin wave, order 2",
-       quantity="fitted order (integrable chain)", target=2.0, within=0.15, quick=dict(Ns=(16, 32)),
+       quantity="fitted order furthest from 2 over both chains", target=2.0, within=0.15, quick=dict(Ns=(16, 32, 64)),
        full=dict(Ns=(16, 32, 64, 128)))
 def spin_chain_smooth_limit(ctx, Ns):
-    J, errors = 1.0, []
-    for N in Ns:
-        flow = heisenberg.scaled_flow("integrable", J, 2 * np.pi / N)
-        _, Ss = dg.integrate(flow, jnp.asarray(spin_wave(N, 0.0, J)), 1.0, steps=N * N // 2)
-        errors.append(float(np.max(np.abs(np.asarray(Ss[-1]) - spin_wave(N, 1.0, J)))))
-    table = dg.limits.ConvergenceTable.from_errors(Ns, errors, "max_i dist(S_i(1), S(x_i, 1))")
-    return ctx.convergence(table, "convergence_spin_wave").fitted_order
+    J, orders = 1.0, []
+    for kind in ("naive", "integrable"):
+        def error(N, kind=kind):
+            flow = heisenberg.scaled_flow(kind, J, 2 * np.pi / N)
+            _, Ss = dg.integrate(flow, jnp.asarray(spin_wave(N, 0.0, J)), 1.0, steps=N * N // 2)
+            return float(np.max(np.abs(np.asarray(Ss[-1]) - spin_wave(N, 1.0, J))))
+
+        table = dg.limits.convergence(error, Ns, label=f"max_i dist(S_i(1), S(x_i, 1)), {kind}")
+        orders.append(ctx.convergence(table, f"convergence_spin_wave_{kind}").fitted_order)
+    return max(orders, key=lambda p: abs(p - 2.0))
 
 
 @check("Appendix A", "(H − H_aligned)/ε tends to (J/2)∫|S'|² dx = πJk² sin²θ on a spin wave",

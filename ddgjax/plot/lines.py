@@ -11,27 +11,20 @@ from typing import Sequence
 
 import numpy as np
 
-from .curves import Curve, _as_curve
-from .errors import InvalidInputError
-from .limits import ConvergenceTable
+from ..curves import Curve, _as_curve
+from ..errors import InvalidInputError
+from ..limits import ConvergenceTable
+from ._figure import pyplot, save_figure
 
-__all__ = ["curve", "curves", "convergence", "save_figure"]
+__all__ = ["curve", "curves", "convergence", "spin_chain", "animate_spin_chain"]
 
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _axes(ax, dim: int):
     """`ax` or a new figure's axes, 3-D for space curves."""
     if ax is not None:
         return ax
-    fig = _pyplot().figure(figsize=(4.5, 4.0))
+    fig = pyplot().figure(figsize=(4.5, 4.0))
     return fig.add_subplot(projection="3d" if dim == 3 else None)
 
 
@@ -39,14 +32,6 @@ def _polyline(gamma, closed: bool) -> np.ndarray:
     """The vertices as a numpy array, with the first repeated at the end of a closed curve."""
     points = np.asarray(_as_curve(gamma, closed))
     return np.vstack([points, points[:1]]) if closed else points
-
-
-def save_figure(fig, path, dpi: int = 120):
-    """Lay out `fig`, write it to `path` (PNG by its suffix), close it; returns `path`."""
-    fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    _pyplot().close(fig)
-    return path
 
 
 def _finish(ax, path):
@@ -88,7 +73,7 @@ def curves(
     if not polylines:
         raise InvalidInputError("curves: the family is empty, nothing to draw")
     ax = _axes(ax, polylines[0].shape[1])
-    colours = _pyplot().get_cmap(cmap)(np.linspace(0.0, 1.0, max(len(polylines), 2)))
+    colours = pyplot().get_cmap(cmap)(np.linspace(0.0, 1.0, max(len(polylines), 2)))
     for i, points in enumerate(polylines):
         label = None if labels is None else labels[i]
         ax.plot(*points.T, color=colours[i], label=label, **kw)
@@ -98,11 +83,17 @@ def curves(
 
 
 def convergence(table: ConvergenceTable, path, *, title: str | None = None):
-    """Log-log plot of a `ddgjax.limits.ConvergenceTable` with its fitted slope; saves `path`.
-
-    The same figure as `table.plot(path)`; returns `path`.
-    """
-    return table.plot(path, title=title)
+    """Log-log plot of a `ddgjax.limits.ConvergenceTable`: the errors against n and a reference
+    line of slope −p, p the fitted order; saves `path` and returns it (= `table.plot(path)`)."""
+    fig, ax = pyplot().subplots(figsize=(4.5, 3.5))
+    ax.loglog(table.ns, table.errors, "o-", label=table.label)
+    reference = table.errors[0] * (table.ns / table.ns[0]) ** (-table.fitted_order)
+    ax.loglog(table.ns, reference, "--", color="gray", label=f"slope −{table.fitted_order:.2f}")
+    ax.set_xlabel("n")
+    ax.set_ylabel(table.label)
+    ax.set_title(title or f"fitted order {table.fitted_order:.2f}")
+    ax.legend()
+    return save_figure(fig, path)
 
 
 def spin_chain(S, ax=None, *, path=None, title: str | None = None):
@@ -124,7 +115,7 @@ def animate_spin_chain(Ss, path, *, times=None, fps: int = 10):
     writer.  Returns `path`."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
-    plt = _pyplot()
+    plt = pyplot()
     fig = plt.figure(figsize=(4.0, 3.6))
     ax = fig.add_subplot(projection="3d")
 

@@ -41,10 +41,10 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from . import quaternion as qt
-from .errors import InvalidInputError
-from .flows import integrate
-from .frames import angular_velocity
+from .. import quaternion as qt
+from ..errors import InvalidInputError
+from ..flows import integrate
+from ..frames import angular_velocity
 
 __all__ = [
     "TopState",
@@ -71,7 +71,7 @@ class TopState(NamedTuple):
 
 def _axis(Phi: Array) -> Array:
     """`T = Φ i Φ̄` (= Φ i Φ⁻¹ on H_1; a quadratic polynomial in Φ everywhere)."""
-    return qt._mul(qt._mul(Phi, jnp.asarray([0.0, 1.0, 0.0, 0.0])), qt._conj(Phi))[..., 1:]
+    return qt.mul(qt.mul(Phi, jnp.asarray([0.0, 1.0, 0.0, 0.0])), qt.conj(Phi))[..., 1:]
 
 
 def action_density(Phi, dPhi, *, alpha: float, a) -> Float[Array, "..."]:
@@ -87,7 +87,7 @@ def action_density(Phi, dPhi, *, alpha: float, a) -> Float[Array, "..."]:
 
 def lagrangian(Phi, Omega, *, alpha: float, a) -> Float[Array, "..."]:
     """`L(Φ, Ω) = action_density(Φ, ½ Φ Ω)`: (3.10) in the body angular velocity (= <Ω, JΩ> + 2<a, T>)."""
-    dPhi = 0.5 * qt._mul(Phi, jnp.concatenate([jnp.zeros_like(Omega[..., :1]), Omega], axis=-1))
+    dPhi = 0.5 * qt.mul(Phi, jnp.concatenate([jnp.zeros_like(Omega[..., :1]), Omega], axis=-1))
     return action_density(Phi, dPhi, alpha=alpha, a=a)
 
 
@@ -121,7 +121,7 @@ def hamiltonian(*, alpha: float, a) -> Callable[[TopState], Array]:
 
 def _body_derivative(F: Callable, Phi: Array) -> Array:
     """`D_Φ F`: `<D_Φ F, η> = d/dε F(Φ(1 + εη/2))` at ε = 0 (body-frame variations of Φ)."""
-    return jax.grad(lambda eta: F(Phi + 0.5 * qt._mul(Phi, jnp.concatenate([jnp.zeros(1), eta]))))(jnp.zeros(3))
+    return jax.grad(lambda eta: F(Phi + 0.5 * qt.mul(Phi, jnp.concatenate([jnp.zeros(1), eta]))))(jnp.zeros(3))
 
 
 def vector_field(*, alpha: float, a) -> Callable[[TopState], TopState]:
@@ -135,9 +135,9 @@ def vector_field(*, alpha: float, a) -> Callable[[TopState], TopState]:
 
 def equations_of_motion(state: TopState, alpha, a) -> TopState:
     """`(Φ', M')` of `vector_field` without validation: traceable in α and a (for shooting,
-    `ddgjax.kirchhoff`)."""
+    `ddgjax.smooth.kirchhoff`)."""
     Omega = _velocity_of_momentum(state.Phi, state.M, alpha, a)
-    dPhi = 0.5 * qt._mul(state.Phi, jnp.concatenate([jnp.zeros(1), Omega]))
+    dPhi = 0.5 * qt.mul(state.Phi, jnp.concatenate([jnp.zeros(1), Omega]))
     torque = _body_derivative(lambda Phi: lagrangian(Phi, Omega, alpha=alpha, a=a), state.Phi)
     return TopState(dPhi, jnp.cross(state.M, Omega) + torque)
 
@@ -145,7 +145,7 @@ def equations_of_motion(state: TopState, alpha, a) -> TopState:
 def _check_parameters(alpha, a) -> None:
     if not (np.ndim(alpha) == 0 and float(alpha) > 0):
         raise InvalidInputError(f"the inertia ratio alpha must be a positive number (J = diag(α, 1, 1)), got {alpha}")
-    qt._as_vector(a, "a")
+    qt.as_vector(a, "a")
 
 
 def initial_state(Phi0, Omega0, *, alpha: float, a) -> TopState:
@@ -154,9 +154,9 @@ def initial_state(Phi0, Omega0, *, alpha: float, a) -> TopState:
     **Raises:** `InvalidInputError` (Φ0 not unit, α ≤ 0), `ShapeError`, `NonFiniteError`.
     """
     _check_parameters(alpha, a)
-    Phi0 = qt._as_quaternion(Phi0, "Phi0")
+    Phi0 = qt.as_quaternion(Phi0, "Phi0")
     qt.check_unit(Phi0, "Phi0")
-    Omega0 = qt._as_vector(Omega0, "Omega0")
+    Omega0 = qt.as_vector(Omega0, "Omega0")
     return TopState(Phi0, momentum(Phi0, Omega0, alpha=alpha, a=jnp.asarray(a, dtype=float)))
 
 
@@ -173,7 +173,7 @@ def _conserved(Phi, M, alpha, a):
     energy = jnp.vectorize(lambda P, N: H(TopState(P, N)), signature="(4),(3)->()")(Phi, M)
     return {
         "energy": energy,
-        "vertical_momentum": qt._rotate(Phi, M) @ a / jnp.linalg.norm(a),
+        "vertical_momentum": qt.rotate(Phi, M) @ a / jnp.linalg.norm(a),
         "axial_momentum": M[..., 0],
         "norm_squared": jnp.sum(Phi**2, axis=-1),
     }

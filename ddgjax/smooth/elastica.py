@@ -41,7 +41,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipj, ellipk, elliprd, elliprf
 
-from .errors import InvalidInputError
+from ..errors import InvalidInputError
 
 __all__ = [
     "elliptic_e",

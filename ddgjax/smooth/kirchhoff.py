@@ -11,7 +11,7 @@ frame, read with arc length as time, is a motion of the Lagrange top (Sec 3.4.1)
     Φ(L) = ±q1   (3 conditions: Im(q1⁻¹ Φ(L)) = 0),      ∫_0^L T ds = c   (3 conditions),
 
 six equations for the six unknowns (M0, a): the body angular momentum at s = 0 and the load.
-The top's equations of motion come from `ddgjax.top.equations_of_motion` (derived by autodiff
+The top's equations of motion come from `ddgjax.smooth.top.equations_of_motion` (derived by autodiff
 of (3.10)), γ' = T = Φ i Φ⁻¹ is integrated alongside with diffrax (8th-order Dormand–Prince,
 tolerance 1e-13), and the shooting equations are solved by optimistix's Levenberg–Marquardt
 method with the Jacobian by forward-mode differentiation through the integrator.
@@ -33,10 +33,10 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array, Float
 
-from . import quaternion as qt
-from .curves import from_tangents
-from .errors import ConvergenceError, InvalidInputError
-from .frames import edge_frame_split
+from .. import quaternion as qt
+from ..curves import from_tangents
+from ..errors import ConvergenceError, InvalidInputError
+from ..frames import edge_frame_split
 from .top import TopState, equations_of_motion
 
 __all__ = [
@@ -63,7 +63,7 @@ def _field(s, y, args):
     Phi, M, _gamma = y
     alpha, a = args
     d = equations_of_motion(TopState(Phi, M), alpha, a)
-    return d.Phi, d.M, qt._rotate(Phi, E1)
+    return d.Phi, d.M, qt.rotate(Phi, E1)
 
 
 def _integrate(Phi0, M0, a, alpha, length, ts):
@@ -91,7 +91,7 @@ _sample = jax.jit(_integrate)
 def shoot(z: Float[Array, "6"], Phi0, Phi1, chord, alpha, length) -> Float[Array, "6"]:
     """The shooting residual of z = (M0, a): `(Im(Φ1⁻¹ Φ(L)), γ(L) − chord)`."""
     Phi, _M, gamma = _integrate(Phi0, z[:3], z[3:], alpha, length, jnp.array([length]))
-    return jnp.concatenate([qt._mul(qt._conj(Phi1), Phi[0])[1:], gamma[0] - chord])
+    return jnp.concatenate([qt.mul(qt.conj(Phi1), Phi[0])[1:], gamma[0] - chord])
 
 
 _shoot = jax.jit(shoot)
@@ -151,7 +151,7 @@ def from_discrete(problem, solution, *, tol: float = 1e-11) -> SmoothRod:
     Omega = 4 * qt.log(qt.mul(qt.conj(q0), solution.x[0])) / h
     return clamped_rod(
         alpha=alpha, length=h * solution.x.shape[0], chord=p["chord"], frame_start=q0, frame_end=p["frame_end"],
-        M0_guess=2 * jnp.array([alpha, 1.0, 1.0]) * Omega, a_guess=solution.multipliers[-3:], tol=tol,
+        M0_guess=2 * jnp.array([alpha, 1.0, 1.0]) * Omega, a_guess=solution.multipliers["chord"], tol=tol,
     )
 
 
@@ -161,10 +161,10 @@ def discrete_errors(problem, solution, smooth: SmoothRod) -> dict[str, float]:
     Phi, h = jnp.asarray(solution.x), problem.params["h"]
     n = Phi.shape[0]
     _, gamma = sample(smooth, np.arange(n + 1) * h)
-    nodes = from_tangents(qt._rotate(Phi, E1), edge_length=h)
+    nodes = from_tangents(qt.rotate(Phi, E1), edge_length=h)
     return {
         "position": float(jnp.max(jnp.linalg.norm(nodes - gamma, axis=1))),
-        "load": float(jnp.max(jnp.abs(solution.multipliers[-3:] - smooth.a))),
+        "load": float(jnp.max(jnp.abs(solution.multipliers["chord"] - smooth.a))),
         "twist": abs(float(jnp.mean(edge_frame_split(Phi)[1])) / h - torsion(smooth)),
     }
 
@@ -191,8 +191,8 @@ def discrete_top_residual(Phi: Float[Array, "n 4"], h: float, alpha: float, a) -
     are O(h²) on samples of a smooth rod (Thm 3.11: a rod's frame is a top motion).
     """
     Phi = jnp.asarray(Phi, dtype=float)
-    T = qt._rotate(Phi, E1)
-    omega = 2 * qt._log(qt._mul(Phi[1:], qt._conj(Phi[:-1]))) / h
+    T = qt.rotate(Phi, E1)
+    omega = 2 * qt.log(qt.mul(Phi[1:], qt.conj(Phi[:-1]))) / h
     Tv = T[:-1] + T[1:]
     Tv = Tv / jnp.linalg.norm(Tv, axis=-1, keepdims=True)
     Te = T[1:-1]

@@ -9,23 +9,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ShapeError
-from .mesh import angle_defect
-from .mesh.connectivity import from_faces
-from .mesh.curvature import boundary_vertex_mask
-from .plot import save_figure
-from .plot_surface import surface
+from ..errors import ShapeError
+from ..mesh import angle_defect
+from ..mesh.connectivity import from_faces
+from ..mesh.curvature import boundary_vertex_mask
+from ._figure import pyplot, save_figure
+from .surface import surface
 
 __all__ = ["harmonic_function", "minimal_surface"]
 
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def harmonic_function(V, F, f, path, *, title: str = "discrete harmonic function", cmap: str = "viridis") -> Path:
@@ -40,7 +32,7 @@ def harmonic_function(V, F, f, path, *, title: str = "discrete harmonic function
         raise ShapeError(f"f must have one value per vertex, shape ({len(V)},), got {f.shape}")
     if V.shape[1] == 3 and np.ptp(V[:, 2]) > 1e-12 * max(np.ptp(V), 1e-300):
         return Path(surface(V, F, path, color_by=f[F].mean(axis=1), cmap=cmap, title=title))
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.0, 4.5))
     shading = ax.tripcolor(V[:, 0], V[:, 1], F, f, shading="gouraud", cmap=cmap)
     ax.tricontour(V[:, 0], V[:, 1], F, f, levels=12, colors="k", linewidths=0.4)
@@ -48,9 +40,7 @@ def harmonic_function(V, F, f, path, *, title: str = "discrete harmonic function
     ax.set_aspect("equal")
     ax.set_title(title)
     fig.colorbar(shading, ax=ax, shrink=0.8, label="f")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return Path(save_figure(fig, path, dpi=110, tight=False))
 
 
 def minimal_surface(V, F, path, *, history=None, title: str = "simplicial minimal surface") -> Path:
@@ -65,7 +55,7 @@ def minimal_surface(V, F, path, *, history=None, title: str = "simplicial minima
     surface(V, F, path, color_by=K[F].mean(axis=1), title=title)
     if history is None:
         return path
-    plt = _pyplot()
+    plt = pyplot()
     history = np.asarray(history, float)
     fig, (left, right) = plt.subplots(1, 2, figsize=(10.0, 4.5), gridspec_kw={"width_ratios": [1.2, 1]})
     left.imshow(plt.imread(path))

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import InvalidInputError, ShapeError
-from .mesh import angle_defect, edge_mean_curvature, edges
-from .mesh.connectivity import faces_as_corners
+from ..errors import InvalidInputError, ShapeError
+from ..mesh import angle_defect, edge_mean_curvature, edges
+from ..mesh.connectivity import faces_as_corners
+from ._figure import pyplot, save_figure
 
 __all__ = ["surface", "face_values"]
 
@@ -48,9 +49,6 @@ def surface(V, F, path=None, *, color_by="angle_defect", cmap="coolwarm", title=
     Returns the figure, or `path` after saving there (PNG or any matplotlib format).
     """
     import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     values = face_values(V, F, color_by)
@@ -59,8 +57,8 @@ def surface(V, F, path=None, *, color_by="angle_defect", cmap="coolwarm", title=
     polygons = np.split(V[vertex], np.flatnonzero(np.diff(face)) + 1)
     scale = max(float(np.max(np.abs(values))), 1e-300)
     norm = matplotlib.colors.Normalize(-scale, scale)
-    colormap = plt.get_cmap(cmap)
-    fig = plt.figure(figsize=(5.0, 4.5))
+    colormap = pyplot().get_cmap(cmap)
+    fig = pyplot().figure(figsize=(5.0, 4.5))
     ax = fig.add_subplot(projection="3d")
     ax.add_collection3d(Poly3DCollection(polygons, facecolors=colormap(norm(values)), edgecolors="k", linewidths=0.2))
     lo, hi = V.min(axis=0), V.max(axis=0)
@@ -73,6 +71,4 @@ def surface(V, F, path=None, *, color_by="angle_defect", cmap="coolwarm", title=
         ax.set_title(title)
     if path is None:
         return fig
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110, tight=False)

@@ -1,0 +1,296 @@
+"""Geometry of triangles from their edge lengths alone (Sec 5.3, 6.3, 7.3).
+
+A triangulation with an edge-length function satisfying the triangle inequalities is a piecewise
+flat surface (Def 5.5, 5.6); its areas, angles, angle defects and the Dirichlet energy of affine
+functions depend on the lengths only (Thm 5.5).  Extrinsic quantities of a mesh (V, F) are these
+functions composed with `edge_lengths(V, F)` (per edge) or `squared_side_lengths(V[F])` (per
+face).
+
+Per-face arrays list the sides *opposite the corners*: `l2[..., k]` is the squared length of the
+side opposite corner k, i.e. of the edge (F[f, k+1], F[f, k+2]) (indices mod 3).
+
+The scalar functions (`triangle_area`, `corner_cotangents`, `face_harmonic_index`) take numpy or
+jax arrays and stay in that library: the flip loop calls them on numpy arrays, the autodiff
+kernels on traced ones.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+from .._checks import is_concrete
+from ..errors import ShapeError, TriangleInequalityError
+from .connectivity import from_faces
+
+__all__ = [
+    "angle_defect_from_lengths",
+    "angle_defects",
+    "corner_angles",
+    "corner_angles_from_lengths",
+    "corner_angles_of_sides",
+    "corner_cotangents",
+    "corner_weights",
+    "defect_from_angles",
+    "dirichlet_energy",
+    "edge_lengths",
+    "face_harmonic_index",
+    "face_side_lengths",
+    "half_cotangents",
+    "squared_side_lengths",
+    "stiffness",
+    "triangle_area",
+]
+
+
+def _xp(*arrays):
+    """jax.numpy if any argument is a jax array (or tracer), else numpy."""
+    return jnp if any(isinstance(a, jax.Array) for a in arrays) else np
+
+
+def _sorted3(a, b, c):
+    """(x, y, z) with x ≥ y ≥ z elementwise, exactly (min / max only, no arithmetic)."""
+    xp = _xp(a, b, c)
+    x = xp.maximum(xp.maximum(a, b), c)
+    z = xp.minimum(xp.minimum(a, b), c)
+    y = xp.maximum(xp.minimum(a, b), xp.minimum(xp.maximum(a, b), c))
+    return x, y, z
+
+
+def triangle_area(a, b, c):
+    """Area of the Euclidean triangle with sides a, b, c by Heron's formula in Kahan's stable
+    order, sides sorted x ≥ y ≥ z:
+
+        A = ¼ √((x + (y + z)) (z − (x − y)) (z + (x − y)) (x + (y − z))),
+
+    accurate for needle-like triangles (no cancellation of rounded sums); NaN when a triangle
+    inequality fails.
+    """
+    x, y, z = _sorted3(a, b, c)
+    return 0.25 * _xp(a, b, c).sqrt((x + (y + z)) * (z - (x - y)) * (z + (x - y)) * (x + (y - z)))
+
+
+def corner_cotangents(a2, b2, c2, area):
+    """The angle criterion's cotangents (law of cosines over twice the area; Lemma 7.17):
+
+        cot α = (b² + c² − a²) / 4A,   cot β = (c² + a² − b²) / 4A,   cot γ = (a² + b² − c²) / 4A,
+
+    α, β, γ the angles opposite the sides with squared lengths a2, b2, c2.  Their sum is
+    h(Δ)/4 (Lemma 7.17).  Used by the Delaunay test of the flip algorithm (Prop 7.9); the cotan
+    weights of the Laplacians come from `stiffness` (autodiff), which agrees with −½ of these.
+    """
+    inv = 0.25 / area
+    return (b2 + c2 - a2) * inv, (c2 + a2 - b2) * inv, (a2 + b2 - c2) * inv
+
+
+def face_harmonic_index(a, b, c, area):
+    """h(Δ) = (a² + b² + c²) / A(Δ) (Def 7.7), = 4 (cot α + cot β + cot γ) by Lemma 7.17."""
+    return (a * a + b * b + c * c) / area
+
+
+def _area_from_squares(l2):
+    """A of each face from its (…, 3) squared side lengths (Kahan's Heron)."""
+    l = jnp.sqrt(l2)
+    return triangle_area(l[..., 0], l[..., 1], l[..., 2])
+
+
+def dirichlet_energy(f: Float[Array, "3"], l2: Float[Array, "3"]) -> Float[Array, ""]:
+    """Dirichlet energy ½ ∫ |∇f|² dA of the affine interpolant of the values f on one triangle,
+    written in its squared side lengths (Sec 6.3), no angles: with the edges e1 = P1 − P0,
+    e2 = P2 − P0 their Gram matrix is
+
+        g11 = l01²,  g22 = l02²,  g12 = (l01² + l02² − l12²) / 2,   √det G = 2A,
+
+    and with d = (f1 − f0, f2 − f0)
+
+        E(f) = (g22 d1² − 2 g12 d1 d2 + g11 d2²) / (4 √det G),
+
+    A by Kahan's Heron (`triangle_area`).  It equals ¼ Σ_k cot α_k (f_{k+1} − f_{k+2})² (Thm 6.6),
+    so its Hessian in f *derives* the cotan weights (`stiffness`).  `l2[k]` is the squared side
+    opposite corner k: l12² = l2[0], l02² = l2[1], l01² = l2[2].
+    """
+    g11, g22 = l2[2], l2[1]
+    g12 = 0.5 * (l2[2] + l2[1] - l2[0])
+    d1, d2 = f[1] - f[0], f[2] - f[0]
+    return (g22 * d1 * d1 - 2.0 * g12 * d1 * d2 + g11 * d2 * d2) / (8.0 * _area_from_squares(l2))
+
+
+def _stiffness(l2):
+    """(nf, 3, 3) Hessians of `dirichlet_energy` in f (it is quadratic: any f, here 0)."""
+    return jax.vmap(jax.hessian(dirichlet_energy), in_axes=(None, 0))(jnp.zeros(3, l2.dtype), l2)
+
+
+@jax.jit
+def stiffness(l2: Float[Array, "nf 3"]) -> Float[Array, "nf 3 3"]:
+    """The local stiffness matrices K = ∇²_f E of `dirichlet_energy`, per face, by autodiff;
+    K[k+1, k+2] = −½ cot α_k (Thm 6.6)."""
+    return _stiffness(l2)
+
+
+def _off_diagonal(K):
+    """(nf, 3): −K[k+1, k+2] = ½ cot α_k, the face's contribution to the weight of the side
+    opposite corner k."""
+    return -K[:, jnp.array([1, 2, 0]), jnp.array([2, 0, 1])]
+
+
+def _sin2(l2):
+    """sin² of the angle at corner 0, 4A² / (l01² l02²) (0 or NaN for a degenerate face)."""
+    return 4.0 * _area_from_squares(l2) ** 2 / (l2[:, 1] * l2[:, 2])
+
+
+def corner_weights(l2: Float[Array, "nf 3"]):
+    """`(w, sin2)`: w (nf, 3) the off-diagonal stiffness entries −K[k+1, k+2] = ½ cot α_k, the
+    contribution of each face to the cotan weight (6.2) of the side opposite corner k, derived
+    by autodiff (`stiffness`); sin2 (nf,) of the angle at corner 0 (to detect degenerate
+    faces).  Traceable (for use inside other jitted kernels); `half_cotangents` is the compiled
+    call on numpy arrays."""
+    return _off_diagonal(_stiffness(l2)), _sin2(l2)
+
+
+def _bucket(n: int) -> int:
+    """n rounded up to one of 8 sizes per octave (at most 12.5 % more, at least 64)."""
+    if n <= 64:
+        return 64
+    step = 1 << (n.bit_length() - 4)
+    return -(-n // step) * step
+
+
+def _on_padded_rows(kernel, X):
+    """`kernel(X)` for X (n, 3) with the rows padded by equilateral triangles (ones) up to
+    `_bucket(n)`, so that a jitted kernel compiles for few shapes; outputs cut back to n rows."""
+    X = np.asarray(X)
+    n = X.shape[0]
+    if _bucket(n) > n:
+        X = np.concatenate([X, np.ones((_bucket(n) - n, 3), dtype=X.dtype)])
+    return jax.tree_util.tree_map(lambda a: np.asarray(a)[:n], kernel(X))
+
+
+_corner_weights = jax.jit(corner_weights)
+
+
+def half_cotangents(l2) -> tuple[np.ndarray, np.ndarray]:
+    """`corner_weights` of the (nf, 3) numpy squared lengths, compiled (for a few shapes)."""
+    return _on_padded_rows(_corner_weights, l2)
+
+
+def squared_side_lengths(P):
+    """(…, 3): |P_{k+1} − P_{k+2}|², the squared side opposite corner k of the triangles P
+    (…, 3, n)."""
+    xp = _xp(P)
+    P0, P1, P2 = P[..., 0, :], P[..., 1, :], P[..., 2, :]
+    D = xp.stack([P2 - P1, P0 - P2, P1 - P0], axis=-2)
+    return xp.sum(D * D, axis=-1)
+
+
+def edge_lengths(V, F):
+    """l(e) = |v_j − v_i| for each edge (i, j) of `ddgjax.mesh.edges(F)`, (ne,)."""
+    E = from_faces(np.asarray(F), n_vertices=jnp.shape(V)[0]).edges
+    return _lengths(jnp.asarray(V), E)
+
+
+@jax.jit
+def _lengths(V, E):
+    return jnp.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=-1)
+
+
+def _triangles(F) -> np.ndarray:
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ShapeError(f"intrinsic angles need triangles, F of shape (nf, 3); got {F.shape}")
+    return F
+
+
+def face_side_lengths(F, lengths):
+    """(nf, 3): entry [f, k] is the length of the side of face f opposite its corner k, i.e. of
+    the edge (F[f, k+1], F[f, k+2]); `lengths` ordered like `ddgjax.mesh.edges(F)`."""
+    h = from_faces(_triangles(F))
+    lengths = jnp.asarray(lengths)
+    if lengths.shape != (h.n_edges,):
+        raise ShapeError(f"lengths must have shape ({h.n_edges},) (one per edge of F), got {lengths.shape}")
+    return lengths[np.roll(h.edge.reshape(-1, 3), -1, axis=1)]
+
+
+def check_triangle_inequalities(L) -> None:
+    """Raise `TriangleInequalityError` naming the first face (row of the (nf, 3) side lengths
+    `L`) with a side longer than the other two together (equality is allowed)."""
+    if not is_concrete(L):
+        return
+    L = np.asarray(L)
+    slack = L.sum(axis=1, keepdims=True) - 2 * L
+    bad = np.argwhere(slack < 0)
+    if bad.size:
+        f = int(bad[0, 0])
+        raise TriangleInequalityError(
+            f"face {f} has side lengths {tuple(float(x) for x in L[f])}: the side opposite corner "
+            f"{int(bad[0, 1])} is longer than the other two together"
+        )
+
+
+def _semiperimeter_differences(L):
+    """(2s, 2(s − l_k)) per face with Kahan's ordering: sides sorted x ≥ y ≥ z and
+    2(s − x) = z − (x − y), 2(s − y) = z + (x − y), 2(s − z) = x + (y − z), each exact up to one
+    rounding (no cancellation of rounded sums)."""
+    order = jnp.argsort(-L, axis=1)
+    x, y, z = (jnp.take_along_axis(L, order[:, i : i + 1], axis=1)[:, 0] for i in range(3))
+    d_sorted = jnp.stack([z - (x - y), z + (x - y), x + (y - z)], axis=1)
+    return x + (y + z), jnp.take_along_axis(d_sorted, jnp.argsort(order, axis=1), axis=1)
+
+
+def corner_angles(L: Float[Array, "nf 3"]) -> Float[Array, "nf 3"]:
+    """Corner angles (nf, 3) of triangles with side lengths L (L[f, k] opposite corner k), by the
+    half-angle form of the law of cosines:
+
+        tan(α/2) = √((s − b)(s − c) / (s (s − a))),   s = (a + b + c)/2,
+
+    a the side opposite the corner, the differences s − l in Kahan's stable order.  Unlike
+    arccos((b² + c² − a²)/2bc) it keeps full relative accuracy for angles near 0 and π.
+    """
+    two_s, D = _semiperimeter_differences(L)
+    Db, Dc = jnp.roll(D, -1, axis=1), jnp.roll(D, 1, axis=1)
+    return 2 * jnp.arctan2(jnp.sqrt(Db * Dc), jnp.sqrt(two_s[:, None] * D))
+
+
+_corner_angles = jax.jit(corner_angles)
+
+
+def corner_angles_of_sides(L) -> np.ndarray:
+    """`corner_angles` of concrete (nf, 3) side lengths, compiled (for a few shapes)."""
+    return _on_padded_rows(_corner_angles, L)
+
+
+def corner_angles_from_lengths(F, lengths):
+    """Corner angles (nf, 3) of the triangles F from edge lengths ordered like
+    `ddgjax.mesh.edges(F)` (`corner_angles` of `face_side_lengths`).
+
+    **Raises:** `ShapeError` for non-triangles or lengths of the wrong shape,
+    `TriangleInequalityError` naming the first face whose lengths violate a triangle inequality.
+    """
+    L = face_side_lengths(F, lengths)
+    check_triangle_inequalities(L)
+    return corner_angles(L) if not is_concrete(L) else jnp.asarray(corner_angles_of_sides(L))
+
+
+@jax.jit
+def defect_from_angles(angles, vertex, boundary):
+    """K(p) = 2π − Σ α at interior vertices (Def 5.2), φ(p) = π − Σ α at boundary vertices
+    (Remark 5.4), from the flat corner angles, their vertices and the (nv,) boundary mask."""
+    total = jax.ops.segment_sum(angles, vertex, boundary.shape[0])
+    return jnp.where(boundary, jnp.pi, 2 * jnp.pi) - total
+
+
+def angle_defects(h, L):
+    """(nv,) K(p) = 2π − Σ α at interior vertices and φ(p) = π − Σ α at boundary vertices (Def
+    5.2, Remark 5.4, Thm 5.5) of the triangles of the connectivity `h` (`Halfedges`) with side
+    lengths L (nf, 3), L[f, k] opposite corner k."""
+    angles = (corner_angles(L) if not is_concrete(L) else corner_angles_of_sides(L)).reshape(-1)
+    return defect_from_angles(angles, jnp.asarray(h.vertex), jnp.asarray(h.boundary_vertex_mask))
+
+
+def angle_defect_from_lengths(F, lengths):
+    """`angle_defects` of the triangles F with edge lengths ordered like `ddgjax.mesh.edges(F)`,
+    (nv,) with nv = max(F) + 1."""
+    L = face_side_lengths(F, lengths)
+    check_triangle_inequalities(L)
+    return angle_defects(from_faces(_triangles(F)), L)

@@ -1,0 +1,20 @@
+"""Smooth reference solutions: the oracles that discrete solutions converge to.
+
+- `elastica`: exact planar elastica from Jacobi elliptic functions (Thm 3.1, 3.2, Remark 3.2);
+- `top`: the Lagrange top, its action (3.10) and equations of motion by autodiff (Sec 3.4.1);
+- `kirchhoff`: smooth clamped rods by shooting with the top (Thm 3.11, 3.13); imported on first
+  use (it loads diffrax and optimistix).
+
+Nothing here uses a discrete energy of `energies/`: these are independent computations.
+"""
+
+import importlib as _importlib
+
+from . import elastica as elastica
+from . import top as top
+
+
+def __getattr__(name: str):
+    if name == "kirchhoff":
+        return _importlib.import_module(".kirchhoff", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,0 +1,159 @@
+"""Geometry from edge lengths (Sec 5.3, 6.3, Lemma 7.17) and the one derived cotan Laplacian:
+the autodiff Hessian of the Dirichlet energy on squared lengths, against the typed cotangent
+formula as an independent oracle, extrinsically (Def 6.2), intrinsically and after edge flips
+(Def 7.8)."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import ddgjax as dg
+from ddgjax.intrinsic import triangulation as T
+from ddgjax.mesh import lengths
+from ddgjax.mesh.builtin import grid_quads, icosphere, tall_dome, torus, triangulate
+
+
+def _jittered_grid(m=12, n=12, seed=0):
+    rng = np.random.default_rng(seed)
+    X, Y = np.meshgrid(np.linspace(0, 1, m), np.linspace(0, 1, n), indexing="ij")
+    V = np.column_stack([X.ravel(), Y.ravel(), np.zeros(m * n)])
+    V[:, :2] += rng.uniform(-0.03, 0.03, (m * n, 2))
+    V[:, 2] = 0.3 * np.sin(3 * V[:, 0]) * V[:, 1]
+    return V, triangulate(grid_quads(m, n, False, False))
+
+
+def _ellipsoid():
+    V, F = icosphere(3)
+    return V * np.array([12.0, 1.0, 0.5]), F
+
+
+def _sheared_torus():
+    V, F = torus(24, 8)
+    return V @ np.array([[1.0, 0, 0], [0, 1.0, 0], [3.0, 0, 1.0]]).T * np.array([1.0, 0.3, 1.0]), F
+
+
+MESHES = {
+    "icosphere": lambda: icosphere(3),
+    "torus": lambda: torus(24, 8),
+    "jittered_grid": _jittered_grid,
+    "ellipsoid": _ellipsoid,
+    "sheared_torus": _sheared_torus,
+    "tall_dome": lambda: tall_dome(0)[:2],
+}
+
+
+def _oracle_laplacian(n, I, J, cot):
+    """L = Σ over corners of ½ cot α on the opposite side (i, j): the typed formula (6.2),
+    loops dropped."""
+    keep = I != J
+    I, J, w = I[keep], J[keep], 0.5 * cot[keep]
+    W = sp.coo_matrix((np.r_[w, w], (np.r_[I, J], np.r_[J, I])), shape=(n, n)).tocsr()
+    return sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W
+
+
+def _extrinsic_oracle(V, F):
+    """cot α_k = (e · e') / |e × e'| with e, e' the sides at corner k, in positions."""
+    cot = np.empty(F.shape)
+    for k in range(3):
+        u, w = V[F[:, (k + 1) % 3]] - V[F[:, k]], V[F[:, (k + 2) % 3]] - V[F[:, k]]
+        cot[:, k] = np.einsum("ij,ij->i", u, w) / np.linalg.norm(np.cross(u, w), axis=1)
+    return _oracle_laplacian(len(V), F[:, [1, 2, 0]].ravel(), F[:, [2, 0, 1]].ravel(), cot.ravel())
+
+
+def _intrinsic_oracle(tri):
+    """cot α_k = (b² + c² − a²) / 4A from the lengths of `tri`, A by Heron in its plain form."""
+    L = T.opposite_side_lengths(tri)
+    a, b, c = L.T
+    s = 0.5 * (a + b + c)
+    A = np.sqrt(s * (s - a) * (s - b) * (s - c))
+    cot = np.stack([(b * b + c * c - a * a), (c * c + a * a - b * b), (a * a + b * b - c * c)], 1) / (4 * A[:, None])
+    F = tri.F
+    return _oracle_laplacian(tri.n_vertices, F[:, [1, 2, 0]].ravel(), F[:, [2, 0, 1]].ravel(), cot.ravel())
+
+
+def _rel(A, B) -> float:
+    return float(abs(A - B).max() / abs(B).max())
+
+
+def test_lemma_7_17_corner_cotangents_are_minus_twice_the_derived_stiffness():
+    """The angle criterion's law of cosines (`corner_cotangents`) equals −2 × the off-diagonal of
+    the autodiff Hessian of the Dirichlet energy on squared lengths (Thm 6.6)."""
+    rng = np.random.default_rng(1)
+    P = rng.normal(size=(500, 3, 3))
+    l2 = lengths.squared_side_lengths(P)
+    l = np.sqrt(l2)
+    A = lengths.triangle_area(l[:, 0], l[:, 1], l[:, 2])
+    cot = np.stack(lengths.corner_cotangents(l2[:, 0], l2[:, 1], l2[:, 2], A), axis=1)
+    K = np.asarray(lengths.stiffness(l2))
+    off = K[:, [1, 2, 0], [2, 0, 1]]
+    scale = np.abs(cot).max(axis=1, keepdims=True)
+    assert np.max(np.abs(cot + 2 * off) / scale) < 1e-12
+    np.testing.assert_allclose(K.sum(axis=2), 0, atol=1e-12 * np.abs(K).max())  # constants in the kernel
+
+
+def test_dirichlet_energy_on_lengths_equals_the_cotangent_form():
+    """E(f) = ¼ Σ_k cot α_k (f_{k+1} − f_{k+2})² (Sec 6.3), the energy written without angles."""
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        P, f = rng.normal(size=(3, 3)), rng.normal(size=3)
+        l2 = lengths.squared_side_lengths(P)
+        cot = np.array([np.dot(P[(k + 1) % 3] - P[k], P[(k + 2) % 3] - P[k])
+                        / np.linalg.norm(np.cross(P[(k + 1) % 3] - P[k], P[(k + 2) % 3] - P[k])) for k in range(3)])
+        expected = 0.25 * sum(cot[k] * (f[(k + 1) % 3] - f[(k + 2) % 3]) ** 2 for k in range(3))
+        assert abs(float(lengths.dirichlet_energy(f, l2)) - expected) < 1e-12 * (1 + abs(expected))
+
+
+@pytest.mark.parametrize("name", list(MESHES))
+def test_def_6_2_derived_laplacians_equal_the_typed_formula(name):
+    """`laplace.cotan_laplacian(V, F)` (extrinsic composition) and `intrinsic.cotan_laplacian`
+    (on the lengths of `from_mesh`) both equal the typed cotangent formula to 1e-12 max|L|."""
+    V, F = MESHES[name]()
+    L_oracle = _extrinsic_oracle(V, F)
+    assert _rel(dg.laplace.cotan_laplacian(V, F), L_oracle) < 1e-12
+    assert _rel(dg.intrinsic.cotan_laplacian(dg.intrinsic.from_mesh(V, F)), L_oracle) < 1e-12
+
+
+@pytest.mark.parametrize("name", list(MESHES))
+def test_def_7_8_laplace_beltrami_is_the_derived_laplacian_after_flips(name):
+    """`laplace_beltrami(V, F)` equals the typed formula on the lengths of the intrinsic Delaunay
+    triangulation; `FlipResult.cotan_weights()` (derived) equals ½ Σ of the cotangents cached
+    by the flip loop's angle test (law of cosines) to 1e-12."""
+    V, F = MESHES[name]()
+    result = dg.intrinsic.flip_to_delaunay(dg.intrinsic.from_mesh(V, F))
+    tri = result.triangulation
+    assert _rel(dg.intrinsic.laplace_beltrami(V, F), _intrinsic_oracle(tri)) < 1e-12
+    cached = 0.5 * np.bincount(tri.edge, result.halfedge_cotangents, minlength=tri.n_edges)
+    nu = result.cotan_weights()
+    assert np.max(np.abs(nu - cached)) < 1e-12 * np.abs(cached).max()
+
+
+def test_multiple_edges_add_and_loops_drop_out():
+    """After the flip of Example 5.5 the tetrahedron has two edges between one pair of vertices:
+    their weights add in L; a self-glued triangle's loop drops out."""
+    V, F = dg.mesh.tetrahedron()
+    flipped = dg.intrinsic.flip(dg.intrinsic.from_mesh(V, F), 0)
+    assert len(np.unique(np.sort(flipped.edges, 1), axis=0)) == 5
+    assert _rel(dg.intrinsic.cotan_laplacian(flipped), _intrinsic_oracle(flipped)) < 1e-12
+    cone = T.from_gluing([1, 0, -1], [[1.0, 1.0, 0.6]])
+    L = dg.intrinsic.cotan_laplacian(cone)
+    assert _rel(L, _intrinsic_oracle(cone)) < 1e-12
+    assert abs(L @ np.ones(cone.n_vertices)).max() < 1e-15
+
+
+def test_one_connectivity_type_for_meshes_and_intrinsic_triangulations():
+    """`intrinsic.Triangulation` is a `mesh.Halfedges` plus lengths: the same edges as
+    `mesh.from_faces`, and mesh topology accepts its connectivity."""
+    V, F = torus(12, 6)
+    tri = dg.intrinsic.from_mesh(V, F)
+    h = dg.mesh.from_faces(F)
+    assert isinstance(tri.connectivity, dg.mesh.Halfedges)
+    np.testing.assert_array_equal(tri.edge, h.edge)
+    np.testing.assert_array_equal(np.sort(tri.edges, 1), h.edges)
+    assert dg.mesh.euler_characteristic(tri.connectivity) == 0
+    stretched = dg.intrinsic.from_mesh(V * [6.0, 1, 1], F)
+    result = dg.intrinsic.flip_to_delaunay(stretched)
+    flipped = result.triangulation
+    assert result.n_flips > 0
+    assert dg.mesh.euler_characteristic(flipped.connectivity) == 0 and dg.mesh.is_orientable(flipped.connectivity)
+    np.testing.assert_allclose(np.asarray(lengths.angle_defects(flipped.connectivity, T.opposite_side_lengths(flipped))),
+                               np.asarray(dg.mesh.angle_defect(V * [6.0, 1, 1], F)), atol=1e-12)
