@@ -15,11 +15,12 @@
   batch (an edge whose triangles change again later is tested again by that later flip, so the
   queue always holds every edge that may be non-Delaunay).  Every flip is one step of Fig 7.13,
   recorded in the history.  The test keys cot + tol · s of all corners and the areas of all
-  faces are cached and updated at each flip, so a test is four array lookups; the cotangents
-  come from the law of cosines (`ddgjax.mesh.lengths.corner_cotangents`).  The cotan weights
-  of the result are not these cotangents but the derived ones (`triangulation.cotan_weights`,
-  the autodiff Hessian of the Dirichlet energy).  No JIT: numpy's vectorised gathers and
-  scatters, where scattered writes and boolean compressions are the cost, so a flip writes as
+  faces are cached and updated at each flip, so a test is four array lookups.  The keys of
+  the start and the cotan weights of the result are the derived ones (`triangulation.
+  halfedge_cotangents`: the autodiff Hessian of the Dirichlet energy); the keys of the triangles
+  a flip creates come from the law of cosines (`ddgjax.mesh.lengths.corner_cotangents`), one
+  vectorised expression per round.  The flip loop itself is not jitted: numpy's vectorised
+  gathers and scatters, where scattered writes and boolean compressions are the cost, so a flip writes as
   few entries as it can (`flips.flip_batch`).
 
 Surfaces with boundary (which the reference does not treat) keep their boundary edges; only
@@ -39,12 +40,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FlipBudgetError, InvalidInputError
-from ..mesh.lengths import corner_cotangents, face_harmonic_index, triangle_area
+from ..mesh.lengths import corner_cotangents, face_harmonic_index, side_cotangents, triangle_area
 from .flips import flip_batch, others
 from .geometry import flipped_length
 from .triangulation import (
     Triangulation,
     cotan_weights,
+    halfedge_cotangents,
     from_faces,
     of_arrays,
     side_lengths,
@@ -86,16 +88,12 @@ def _interior(tri: Triangulation) -> np.ndarray:
 
 
 def _face_geometry(tri: Triangulation):
-    """(cot, area, s): per halfedge the cot of the angle opposite it (3 nf,), per face its area
-    and s = (a² + b² + c²)/4A = h(Δ)/4 (nf,) (`corner_cotangents`, Lemma 7.17)."""
+    """(cot, area, s): per halfedge the cot of the angle opposite it (3 nf,), derived from the
+    Dirichlet energy (`triangulation.halfedge_cotangents`); per face its area and
+    s = cot α + cot β + cot γ = (a² + b² + c²)/4A = h(Δ)/4 (nf,) (Lemma 7.17)."""
     L = side_lengths(tri)
-    a, b, c = L[:, 0].copy(), L[:, 1].copy(), L[:, 2].copy()  # contiguous columns
-    A = triangle_area(a, b, c)
-    a2, b2, c2 = a * a, b * b, c * c
-    cots = np.empty_like(L)
-    for i, cot in enumerate(corner_cotangents(a2, b2, c2, A)):
-        cots[:, i] = cot
-    return cots.reshape(-1), A, (a2 + b2 + c2) * (0.25 / A)
+    cots, area = side_cotangents(L * L)
+    return cots.reshape(-1), np.array(area), cots.sum(axis=1)  # the area is updated by the flips
 
 
 def edge_cotangent_sums(tri: Triangulation) -> np.ndarray:
@@ -145,7 +143,7 @@ class FlipResult:
     ((n_flips + 1,) h(T) before the first and after every flip, or just the first and last value
     when the history was not recorded); `harmonic_index_steps` ((n_flips,) the change of h at each
     flip, all < 0 by Cor 7.19; empty when not recorded); `halfedge_cotangents` ((3 nf,) the cot
-    of the angle opposite each halfedge of the result, as cached by the angle test).
+    of the angle opposite each halfedge of the result, derived from the Dirichlet energy).
     """
 
     triangulation: Triangulation
@@ -158,7 +156,7 @@ class FlipResult:
     def cotan_weights(self) -> np.ndarray:
         """(ne,) ν(e) = ½ (cot α + cot β) of the Delaunay triangulation (eq 6.2), derived from
         the Dirichlet energy (`triangulation.cotan_weights`)."""
-        return cotan_weights(self.triangulation)
+        return cotan_weights(self.triangulation, self.halfedge_cotangents)
 
     @property
     def F(self) -> np.ndarray:
@@ -181,8 +179,8 @@ class _Work:
     """Mutable working copy for the flip loop: the flat gluing arrays; per halfedge the test key
     cot + tol · s(face) of the opposite angle (one more entry, +inf, read by the boundary's
     halfedge -1, so that boundary edges always pass), per face its area (kept up to date at each
-    flip, so that the test of an edge, key(h) + key(t) < 0, is four lookups).  The cotangents
-    of the result are computed once at the end."""
+    flip, so that the test of an edge, key(h) + key(t) < 0, is four lookups).  The derived
+    cotangents of the result are computed once at the end."""
 
     F: np.ndarray
     edge: np.ndarray
@@ -204,13 +202,6 @@ class _Work:
         if copy:
             arrays = tuple(a.copy() for a in arrays)
         return cls(*arrays, key, A, np.full(tri.n_edges, _NONE, dtype=np.int64), tol)
-
-    def cotangents(self):
-        """(cot (3 nf,), s (nf,)) from the keys: the keys of a face sum to s (1 + 3 tol), since
-        its three cotangents sum to s (Lemma 7.17)."""
-        k = self.key[:-1].reshape(-1, 3)
-        s = (k[:, 0] + k[:, 1] + k[:, 2]) / (1.0 + 3.0 * self.tol)
-        return (k - (self.tol * s)[:, None]).reshape(-1), s
 
     def arrays(self):
         return self.F, self.edge, self.halfedges, self.lengths
@@ -362,10 +353,11 @@ def flip_owned(tri: Triangulation, tol: float = DELAUNAY_TOL, max_flips: int | N
                 )
         queue = _unique(np.concatenate(parts), marks)
         n_rounds += n_flips > before
-    out, (cots, _, scales) = tri, geometry
-    if n_flips:
+    out, cots = tri, geometry[0]
+    if n_flips:  # the derived cotangents of the new triangles (the keys hold the law of cosines)
         out = of_arrays(w.F, w.edge, w.halfedges, w.lengths, tri.n_vertices)
-        cots, scales = w.cotangents()
+        cots = halfedge_cotangents(out)
+    scales = cots.reshape(-1, 3).sum(axis=1)
     steps = np.concatenate(steps) if steps else np.zeros(0)
     history = h0 + np.concatenate([[0.0], np.cumsum(steps)]) if record_history else np.array([h0, 4.0 * float(scales.sum())])
     return FlipResult(out, n_flips, n_rounds, history, steps, cots)

@@ -60,24 +60,27 @@ __all__ = [
 ]
 
 
-def cotan_laplacian(tri: Triangulation, labels=None) -> sp.csr_matrix:
+def cotan_laplacian(tri: Triangulation, labels=None, weights=None) -> sp.csr_matrix:
     """The cotan Laplace operator of the geodesic triangulation `tri` (Def 6.2) as an
     (nv, nv) `csr_matrix` L with (L f)_i = Σ_j ν_ij (f_i − f_j), ν the derived weights
     `cotan_weights(tri)` (the autodiff Hessian of the Dirichlet energy on the lengths of `tri`),
     assembled by `ddgjax.laplace.laplacian_of_edge_weights` (multiple edges add their weights,
-    loops drop out); `labels` (nv,) the row of each vertex of `tri` (default the identity).
+    loops drop out); `labels` (nv,) the row of each vertex of `tri` (default the identity);
+    `weights` the ν (ne,) if already known.
     """
     F = tri.F.reshape(-1)
     h = tri.halfedges[:, 0]
     i, j = F[h], F[next_halfedge(h)]
     if labels is not None:
         i, j = labels[i], labels[j]
-    return laplacian_of_edge_weights(i, j, cotan_weights(tri), tri.n_vertices)
+    w = cotan_weights(tri) if weights is None else weights
+    return laplacian_of_edge_weights(i, j, w, tri.n_vertices)
 
 
 def _delaunay_laplacian(tri: Triangulation, tol: float, labels=None, owned: bool = False) -> sp.csr_matrix:
     """`owned`: `tri` was built here, its arrays may be flipped in place."""
-    return cotan_laplacian(flip_owned(tri, tol, copy=not owned).triangulation, labels)
+    result = flip_owned(tri, tol, copy=not owned)
+    return cotan_laplacian(result.triangulation, labels, result.cotan_weights())
 
 
 def laplace_beltrami_from_lengths(F, lengths=None, *, tol: float = DELAUNAY_TOL) -> sp.csr_matrix:

@@ -40,7 +40,7 @@ from ..mesh.connectivity import (
     next_halfedge,
 )
 from ..mesh.lengths import angle_defects as angle_defects_of_sides
-from ..mesh.lengths import corner_angles_of_sides, half_cotangents, triangle_area
+from ..mesh.lengths import corner_angles_of_sides, half_cotangents, side_cotangents, triangle_area
 from ..mesh.lengths import corner_cotangents as cotangents_of_sides
 from .geometry import apex
 
@@ -54,6 +54,7 @@ __all__ = [
     "corner_cotangents",
     "corner_weights",
     "cotan_weights",
+    "halfedge_cotangents",
     "from_checked_mesh",
     "from_faces",
     "from_gluing",
@@ -249,7 +250,7 @@ def _weights_at_opposite_edges(tri: Triangulation) -> tuple[np.ndarray, np.ndarr
     """`(w, edges)`, (nf, 3) each: ½ cot α_k derived by autodiff and the edge opposite corner k."""
     opposite = _opposite_edges(tri)
     L = tri.lengths[opposite]
-    return half_cotangents(L * L)[0], opposite
+    return half_cotangents(L * L), opposite
 
 
 def corner_weights(tri: Triangulation) -> np.ndarray:
@@ -259,11 +260,19 @@ def corner_weights(tri: Triangulation) -> np.ndarray:
     return _weights_at_opposite_edges(tri)[0]
 
 
-def cotan_weights(tri: Triangulation) -> np.ndarray:
+def halfedge_cotangents(tri: Triangulation) -> np.ndarray:
+    """(3 nf,): cot of the angle opposite each halfedge (side i of a face is opposite its corner
+    i + 2), twice the derived `corner_weights`."""
+    L = side_lengths(tri)
+    return side_cotangents(L * L)[0].reshape(-1)
+
+
+def cotan_weights(tri: Triangulation, halfedge_cot: np.ndarray | None = None) -> np.ndarray:
     """(ne,) ν(e) = ½ (cot α + cot β), ½ cot α on the boundary (eq 6.2), in edge order of `tri`:
-    the sum of `corner_weights` over the corners opposite each edge."""
-    w, opposite = _weights_at_opposite_edges(tri)
-    return np.bincount(opposite.reshape(-1), w.reshape(-1), minlength=tri.n_edges)
+    the sum of `corner_weights` over the corners opposite each edge (`halfedge_cot`: the
+    `halfedge_cotangents` of `tri`, if already known)."""
+    cot = halfedge_cotangents(tri) if halfedge_cot is None else halfedge_cot
+    return 0.5 * np.bincount(tri.edge, cot, minlength=tri.n_edges)
 
 
 def corner_angles(tri: Triangulation) -> np.ndarray:

@@ -39,6 +39,7 @@ __all__ = [
     "face_harmonic_index",
     "face_side_lengths",
     "half_cotangents",
+    "side_cotangents",
     "squared_side_lengths",
     "stiffness",
     "triangle_area",
@@ -167,12 +168,31 @@ def _on_padded_rows(kernel, X):
     return jax.tree_util.tree_map(lambda a: np.asarray(a)[:n], kernel(X))
 
 
-_corner_weights = jax.jit(corner_weights)
+@jax.jit
+def _half_cotangents(l2):
+    return _off_diagonal(_stiffness(l2))
 
 
-def half_cotangents(l2) -> tuple[np.ndarray, np.ndarray]:
-    """`corner_weights` of the (nf, 3) numpy squared lengths, compiled (for a few shapes)."""
-    return _on_padded_rows(_corner_weights, l2)
+@jax.jit
+def _side_cotangents(s2):
+    # side i (corner i to i + 1) is opposite corner i + 2: l2[k] = s2[k + 1], cot(side i) = 2 w[i + 2]
+    l2 = s2[:, jnp.array([1, 2, 0])]
+    w = _off_diagonal(_stiffness(l2))
+    return 2.0 * w[:, jnp.array([2, 0, 1])], _area_from_squares(l2)
+
+
+def side_cotangents(s2) -> tuple[np.ndarray, np.ndarray]:
+    """`(cot, area)`: cot (nf, 3) of the angle opposite side i of each face, twice the derived
+    `corner_weights`, and the areas (nf,), for the (nf, 3) numpy squared lengths `s2` of the
+    sides in halfedge order (side i from corner i to corner i + 1); compiled for a few shapes."""
+    return _on_padded_rows(_side_cotangents, s2)
+
+
+def half_cotangents(l2) -> np.ndarray:
+    """(nf, 3): the weights w of `corner_weights` (½ cot α_k, derived by autodiff) for the
+    (nf, 3) numpy squared lengths of triangles already known to be non-degenerate; compiled for
+    a few shapes."""
+    return _on_padded_rows(_half_cotangents, l2)
 
 
 def squared_side_lengths(P):
