@@ -1,5 +1,5 @@
-"""Cotan and graph Laplacians (Sec 6.2, 6.3): Thm 6.6 by autodiff, libigl, invariants, smooth
-limits on regular planar triangulations, bad input, plots."""
+"""Cotan and graph Laplacians (Sec 6.2, 6.3): Thm 6.6 by autodiff, libigl, invariants, bad input,
+plots.  The smooth limits (Def 6.2, Cor 6.4) are `ddgjax verify` checks (`sec6_laplace`)."""
 
 import jax
 import numpy as np
@@ -123,32 +123,6 @@ def square_grid(n):
     F = dg.mesh.triangulate(dg.mesh.builtin.grid_quads(n + 1, n + 1, False, False))
     boundary = np.flatnonzero((x.ravel() % 1 == 0) | (y.ravel() % 1 == 0))
     return V, F, boundary
-
-
-def laplacian_error(n):
-    """max over interior vertices of |−(L f)_i / M_i − Δf(x_i)|, f = sin(πx) cos(2y)."""
-    V, F, b = square_grid(n)
-    x, y = V[:, 0], V[:, 1]
-    f = np.sin(np.pi * x) * np.cos(2 * y)
-    lap = -(np.pi**2 + 4) * f
-    approx = -(dg.laplace.cotan_laplacian(V, F) @ f) / dg.laplace.barycentric_areas(V, F)
-    interior = np.setdiff1d(np.arange(len(V)), b)
-    return np.max(np.abs(approx - lap)[interior])
-
-
-def harmonic_error(n):
-    """max |f − u| for the dDBVP solution f with the boundary values of u = eˣ sin y."""
-    V, F, b = square_grid(n)
-    u = np.exp(V[:, 0]) * np.sin(V[:, 1])
-    f = dirichlet.cotan_sparse(V, F, b, u[b])
-    return np.max(np.abs(f - u))
-
-
-@pytest.mark.parametrize("error, label", [(laplacian_error, "|−Lf/M − Δf|∞"), (harmonic_error, "|f − u|∞")])
-def test_smooth_limit_order_two(error, label):
-    table = dg.limits.convergence(error, [8, 16, 32, 64], label=label)
-    print("\n" + table.to_markdown())
-    assert abs(table.fitted_order - 2.0) < 0.3
 
 
 # Bad input
