@@ -262,10 +262,14 @@ def lagrangian(problem: Problem) -> Callable:
     """
 
     def L(x, multipliers, params):
-        lam = flatten_multipliers(problem, multipliers)
-        return problem.energy(x, params) - jnp.dot(lam, constraint_values(problem, x, params))
+        return _lagrangian_of_flat(problem, x, flatten_multipliers(problem, multipliers), params)
 
     return L
+
+
+def _lagrangian_of_flat(problem: Problem, x, lam, params):
+    """`E(x) − λ·g(x)` with λ the flat multiplier vector."""
+    return problem.energy(x, params) - jnp.dot(lam, constraint_values(problem, x, params))
 
 
 def euler_lagrange(problem: Problem) -> Callable:
@@ -275,12 +279,11 @@ def euler_lagrange(problem: Problem) -> Callable:
     (Sec 3.1).  `multipliers`: the flat vector or, for named constraints, a pytree like the
     constraints' output (`flatten_multipliers`; default zero).  Uses `problem.params`.
     """
-    L = lagrangian(problem)
     free = jax.tree_util.tree_map(lambda m: ~m, problem.fixed)
 
     def f(x, multipliers=None):
         lam = jnp.zeros((problem.n_constraints,)) if multipliers is None else flatten_multipliers(problem, multipliers)
-        grad = jax.grad(L)(x, lam, problem.params)
+        grad = jax.grad(_lagrangian_of_flat, argnums=1)(problem, x, lam, problem.params)
         return jax.tree_util.tree_map(lambda gi, mi: jnp.where(mi, gi, 0.0), grad, free)
 
     return f

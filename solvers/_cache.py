@@ -33,12 +33,6 @@ class LRU:
             self._items.popitem(last=False)
         return value
 
-    def __len__(self) -> int:
-        return len(self._items)
-
-    def clear(self) -> None:
-        self._items.clear()
-
 
 _DERIVED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 

@@ -60,7 +60,13 @@ class SparsePattern:
         """The KKT matrix split at the coupled multipliers; None if there are none."""
         if not self.coupled.size:
             return None
-        return derived(self, "split", lambda: bordered(self.rows, self.cols, self.coupled, self.n + self.m))
+        return derived(self, "split", self._analysed_split)
+
+    def _analysed_split(self) -> Bordered:
+        """The split with KLU's analysis of its block made now, outside any trace."""
+        split = bordered(self.rows, self.cols, self.coupled, self.n + self.m)
+        split.symbolic()
+        return split
 
     def symbolic(self):
         """KLU's symbolic analysis (ordering) of the KKT matrix, made once and kept here.

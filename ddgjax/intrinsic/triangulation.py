@@ -40,7 +40,7 @@ from ..mesh.connectivity import (
     next_halfedge,
 )
 from ..mesh.lengths import angle_defects as angle_defects_of_sides
-from ..mesh.lengths import corner_angles_of_sides, half_cotangents, side_cotangents, triangle_area
+from ..mesh.lengths import corner_angles_of_sides, side_cotangents, triangle_area
 from ..mesh.lengths import corner_cotangents as cotangents_of_sides
 from .geometry import apex
 
@@ -246,25 +246,18 @@ def corner_cotangents(tri: Triangulation) -> np.ndarray:
     return np.stack(cotangents_of_sides(a * a, b * b, c * c, triangle_area(a, b, c)), axis=1)
 
 
-def _weights_at_opposite_edges(tri: Triangulation) -> tuple[np.ndarray, np.ndarray]:
-    """`(w, edges)`, (nf, 3) each: ½ cot α_k derived by autodiff and the edge opposite corner k."""
-    opposite = _opposite_edges(tri)
-    L = tri.lengths[opposite]
-    return half_cotangents(L * L), opposite
+def halfedge_cotangents(tri: Triangulation) -> np.ndarray:
+    """(3 nf,): cot of the angle opposite each halfedge (side i of a face is opposite its corner
+    i + 2), derived as twice the off-diagonal of the Hessian of the Dirichlet energy on the
+    squared lengths (`ddgjax.mesh.lengths.side_cotangents`, Thm 6.6)."""
+    L = side_lengths(tri)
+    return side_cotangents(L * L)[0].reshape(-1)
 
 
 def corner_weights(tri: Triangulation) -> np.ndarray:
     """(nf, 3): ½ cot α_k, each face's contribution to the cotan weight of the side opposite its
-    corner k, derived as the off-diagonal of the Hessian of the Dirichlet energy on the squared
-    lengths (`ddgjax.mesh.lengths.half_cotangents`, Thm 6.6)."""
-    return _weights_at_opposite_edges(tri)[0]
-
-
-def halfedge_cotangents(tri: Triangulation) -> np.ndarray:
-    """(3 nf,): cot of the angle opposite each halfedge (side i of a face is opposite its corner
-    i + 2), twice the derived `corner_weights`."""
-    L = side_lengths(tri)
-    return side_cotangents(L * L)[0].reshape(-1)
+    corner k (side k + 1), from the derived `halfedge_cotangents`."""
+    return 0.5 * halfedge_cotangents(tri).reshape(-1, 3)[:, [1, 2, 0]]
 
 
 def cotan_weights(tri: Triangulation, halfedge_cot: np.ndarray | None = None) -> np.ndarray:

@@ -367,12 +367,6 @@ def glue_triangles(F: np.ndarray, nv: int) -> tuple[Halfedges, np.ndarray]:
     return Halfedges(tail, edge, halfedges, nv, F.shape[0]), keys
 
 
-def _inverse_permutation(p: np.ndarray) -> np.ndarray:
-    inv = np.empty_like(p)
-    inv[p] = np.arange(p.size)
-    return inv
-
-
 def from_gluing(face, h_next, edge, sign) -> Halfedges:
     """Halfedges of polygons glued along labelled edges (each label on one or two sides).
 

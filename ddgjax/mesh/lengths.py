@@ -38,7 +38,6 @@ __all__ = [
     "edge_lengths",
     "face_harmonic_index",
     "face_side_lengths",
-    "half_cotangents",
     "side_cotangents",
     "squared_side_lengths",
     "stiffness",
@@ -145,7 +144,7 @@ def corner_weights(l2: Float[Array, "nf 3"]):
     """`(w, sin2)`: w (nf, 3) the off-diagonal stiffness entries −K[k+1, k+2] = ½ cot α_k, the
     contribution of each face to the cotan weight (6.2) of the side opposite corner k, derived
     by autodiff (`stiffness`); sin2 (nf,) of the angle at corner 0 (to detect degenerate
-    faces).  Traceable (for use inside other jitted kernels); `half_cotangents` is the compiled
+    faces).  Traceable (for use inside other jitted kernels); `side_cotangents` is the compiled
     call on numpy arrays."""
     return _off_diagonal(_stiffness(l2)), _sin2(l2)
 
@@ -169,11 +168,6 @@ def _on_padded_rows(kernel, X):
 
 
 @jax.jit
-def _half_cotangents(l2):
-    return _off_diagonal(_stiffness(l2))
-
-
-@jax.jit
 def _side_cotangents(s2):
     # side i (corner i to i + 1) is opposite corner i + 2: l2[k] = s2[k + 1], cot(side i) = 2 w[i + 2]
     l2 = s2[:, jnp.array([1, 2, 0])]
@@ -186,13 +180,6 @@ def side_cotangents(s2) -> tuple[np.ndarray, np.ndarray]:
     `corner_weights`, and the areas (nf,), for the (nf, 3) numpy squared lengths `s2` of the
     sides in halfedge order (side i from corner i to corner i + 1); compiled for a few shapes."""
     return _on_padded_rows(_side_cotangents, s2)
-
-
-def half_cotangents(l2) -> np.ndarray:
-    """(nf, 3): the weights w of `corner_weights` (½ cot α_k, derived by autodiff) for the
-    (nf, 3) numpy squared lengths of triangles already known to be non-degenerate; compiled for
-    a few shapes."""
-    return _on_padded_rows(_half_cotangents, l2)
 
 
 def squared_side_lengths(P):
