@@ -55,9 +55,9 @@ class ConvergenceTable:
         lines.append(f"\nfitted order: {self.fitted_order:.3f}")
         return "\n".join(lines)
 
-    def plot(self, path, *, title: str | None = None):
-        """Log-log plot of the errors with a reference slope of the fitted order; saves `path`
-        (drawn by `ddgjax.plot.convergence`)."""
+    def plot(self, path=None, *, title: str | None = None):
+        """Log-log plot of the errors against n with a reference line of slope −fitted order
+        (drawn by `ddgjax.plot.convergence`): the figure, or `path` after saving there."""
         from .plot.lines import convergence as draw  # output layer, loaded on use
 
         return draw(self, path, title=title)

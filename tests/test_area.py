@@ -148,10 +148,55 @@ def test_delaunay_method_is_the_harmonic_iteration_with_flips():
     assert info["converged"] and np.array_equal(V1, V2) and np.array_equal(F1, F2)
 
 
+def _rows(colours) -> list:
+    """RGBA rows as a sorted list of rounded tuples."""
+    return sorted(map(tuple, np.round(np.asarray(colours), 12)))
+
+
+def assert_minimal_surface_plot_shows(fig, V, F, history):
+    """`plot_laplace.minimal_surface`'s figure: the surface in 3-D, one polygon per triangle,
+    coloured by the angle defect K at the interior vertices (0 on the boundary) on a colour bar
+    symmetric about 0; beside it the residual history against the iteration on a log scale."""
+    import matplotlib
+
+    surface, bar, history_ax = fig.axes
+    assert [ax.name for ax in fig.axes] == ["3d", "rectilinear", "rectilinear"] and bar.get_label() == "<colorbar>"
+    K = np.array(dg.mesh.angle_defect(V, F))
+    K[np.concatenate(dg.mesh.boundary_loops(F))] = 0.0
+    values = K[F].mean(axis=1)
+    scale = np.max(np.abs(values))
+    assert bar.get_ylim() == pytest.approx((-scale, scale), rel=1e-12) and bar.get_ylabel() == "angle defect K"
+    (faces,) = surface.collections
+    expected = matplotlib.colormaps["coolwarm"]((values + scale) / (2 * scale))
+    assert _rows(faces.get_facecolor()) == _rows(expected)  # whatever order the faces are painted in
+    limits = np.array([surface.get_xlim(), surface.get_ylim(), surface.get_zlim()])
+    assert np.all(limits[:, 0] <= V.min(axis=0)) and np.all(limits[:, 1] >= V.max(axis=0))
+    (line,) = history_ax.lines
+    np.testing.assert_array_equal(line.get_xdata(), np.arange(len(history)))
+    np.testing.assert_array_equal(line.get_ydata(), history)
+    assert history_ax.get_yscale() == "log" and history_ax.get_xlabel() == "iteration"
+    assert history_ax.get_title() == "convergence"
+    fig.canvas.draw()  # the polygons are projected when drawn
+    assert len(faces.get_paths()) == len(F)
+
+
 def test_plot_minimal_surface(tmp_path):
+    import matplotlib.pyplot as plt
+
     from ddgjax.plot import laplace as plot_laplace
 
     V, F = cylinder(4)
     Vm, _, info = area.minimal_surface(V, F, tol=1e-5)
-    path = plot_laplace.minimal_surface(Vm, F, tmp_path / "catenoid.png", history=info["history"])
-    assert path.exists() and path.stat().st_size > 10000
+    history = np.asarray(info["history"])
+    fig = plot_laplace.minimal_surface(Vm, F, history=history, title="catenoid")
+    assert_minimal_surface_plot_shows(fig, Vm, F, history)
+    assert fig.axes[0].get_title() == "catenoid"
+    with pytest.raises(AssertionError):  # negative control: the start cylinder is not the minimal surface
+        assert_minimal_surface_plot_shows(fig, V, F, history)
+    plt.close(fig)
+    fig = plot_laplace.minimal_surface(Vm, F)  # without a history: the surface and its colour bar only
+    assert [ax.name for ax in fig.axes] == ["3d", "rectilinear"]
+    plt.close(fig)
+    path = plot_laplace.minimal_surface(Vm, F, tmp_path / "catenoid.png", history=history)
+    assert path == tmp_path / "catenoid.png"
+    assert plt.imread(path).shape == (495, 1100, 4)  # 10 × 4.5 in at 110 dpi

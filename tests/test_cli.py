@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ddgjax import cli, verify
@@ -42,12 +43,48 @@ def test_debug_shows_the_exception():
         cli.main(["--debug", "solve", "elastica", "--n", "2"])
 
 
-def test_solve_elastica_prints_and_plots(tmp_path, capsys):
-    assert cli.main(["solve", "elastica", "--n", "16", "--chord", "0.6", "0", "0", "--plot", str(tmp_path / "e.png")]) == 0
+@pytest.fixture
+def saved_figures(monkeypatch):
+    """{path: figure} of every figure this process writes with `savefig` during the test."""
+    from matplotlib.figure import Figure
+
+    saved, savefig = {}, Figure.savefig
+
+    def recording(fig, fname, *args, **kwargs):
+        saved[Path(fname)] = fig
+        return savefig(fig, fname, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", recording)
+    return saved
+
+
+def assert_planar_elastica_shown(fig, n, chord, length=1.0):
+    """The `--plot` figure of a planar elastica: one 2-D axes, one polyline of n edges of length
+    length/n from the origin to the chord, all inside the view."""
+    (ax,) = fig.axes
+    (line,) = ax.lines
+    points = np.column_stack(line.get_data())
+    assert ax.name == "rectilinear" and points.shape == (n + 1, 2)
+    np.testing.assert_allclose(points[0], 0.0, atol=1e-12)
+    np.testing.assert_allclose(points[-1], chord, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(np.diff(points, axis=0), axis=1), length / n, rtol=1e-9)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert x0 <= points[:, 0].min() and x1 >= points[:, 0].max() and y0 <= points[:, 1].min() and y1 >= points[:, 1].max()
+
+
+def test_solve_elastica_prints_and_plots(tmp_path, capsys, saved_figures):
+    import matplotlib.pyplot as plt
+
+    path = tmp_path / "e.png"
+    assert cli.main(["solve", "elastica", "--n", "16", "--chord", "0.6", "0", "0", "--plot", str(path)]) == 0
     out = capsys.readouterr().out
     residual = float(re.search(r"KKT residual\s+(\S+)", out).group(1))
-    assert residual <= 1e-10 and "Thm 3.8" in out
-    assert (tmp_path / "e.png").stat().st_size > 2000
+    assert residual <= 1e-10 and "Thm 3.8" in out and re.search(r"figure\s+" + re.escape(str(path)), out)
+    assert plt.imread(path).shape == (480, 540, 4)  # dg.plot.curve: 4.5 × 4 in at 120 dpi
+    assert list(saved_figures) == [path]
+    assert_planar_elastica_shown(saved_figures[path], 16, [0.6, 0.0])
+    with pytest.raises(AssertionError):  # negative control: not the elastica of another chord
+        assert_planar_elastica_shown(saved_figures[path], 16, [0.5, 0.0])
 
 
 def _referenced_figures(report: Path) -> list[Path]:
@@ -56,7 +93,9 @@ def _referenced_figures(report: Path) -> list[Path]:
 
 def test_verify_writes_the_report_with_existing_figures(tmp_path, capsys):
     """Two processes (`--jobs 2`) over two modules' checks: the report has the table, every
-    check passes, every referenced figure exists."""
+    check passes, every referenced figure is a PNG image."""
+    import matplotlib.pyplot as plt
+
     code = cli.main(["verify", "--quick", "--only", "sec4", "steiner", "mean_curvature", "--out", str(tmp_path),
                      "--no-progress", "--jobs", "2"])
     assert code == 0, capsys.readouterr()
@@ -65,7 +104,12 @@ def test_verify_writes_the_report_with_existing_figures(tmp_path, capsys):
     assert "| statement | reference | quantity | value | tolerance | result |" in text
     assert "**FAIL**" not in text and "Thm 4.1" in text and "fitted order" in text
     figures = _referenced_figures(report)
-    assert figures and all(p.is_file() and p.stat().st_size > 2000 for p in figures)
+    assert figures and any(p.name.startswith("convergence_") for p in figures)
+    for path in figures:  # drawn in the worker processes: each a PNG image of its figure's size
+        image = plt.imread(path)
+        assert image.ndim == 3 and image.shape[2] == 4 and min(image.shape[:2]) >= 300
+        if path.name.startswith("convergence_"):
+            assert image.shape == (420, 540, 4)  # dg.plot.convergence: 4.5 × 3.5 in at 120 dpi
 
 
 def test_a_failing_check_gives_exit_code_1(tmp_path, capsys):

@@ -28,12 +28,94 @@ def test_every_example_is_tested():
     assert scripts == set(FAST + SLOW)
 
 
+# What each written figure shows: per axes, (kind, number of lines, kinds of collections).
+BAR = ("rectilinear", 0, ["LineCollection", "QuadMesh"])  # a colour bar
+EDGES = ["LineCollection", "LineCollection"]  # Delaunay and non-Delaunay edges
+SHOWN = {
+    "custom_energy.png": [("rectilinear", 1, [])],
+    "gauss_bonnet_torus.png": [("3d", 0, ["Poly3DCollection"]), BAR],
+    "heisenberg_chain.png": [("3d", 1, ["Line3DCollection"])],  # the ring and the spins' arrows
+    "elastica_family.png": [("rectilinear", 4, [])],
+    "figure_eight.png": [("rectilinear", 1, [])],
+    "pendulum_shooting.png": [("3d", 3, [])],
+    "catenoid.png": [("3d", 0, ["Poly3DCollection"]), BAR, ("rectilinear", 1, [])],
+    "catenoid_profile.png": [("rectilinear", 2, [])],
+    "intrinsic_delaunay_disk.png": [("rectilinear", 1, EDGES)] * 2,
+    "intrinsic_delaunay_ellipsoid.png": [("rectilinear", 0, EDGES)] * 2 + [("rectilinear", 1, [])],
+    "narrow_minimal_surface.png": [("3d", 0, ["Poly3DCollection"])] * 3 + [("rectilinear", 2, [])],
+    "twisted_rod.png": [("3d", 3, [])],
+}
+
+
+@pytest.fixture
+def saved_figures(monkeypatch):
+    """{path: (figure, dpi)} of every figure written to a file with `savefig` during the test."""
+    import os
+
+    from matplotlib.figure import Figure
+
+    saved, savefig = {}, Figure.savefig
+
+    def recording(fig, fname, *args, **kwargs):
+        if isinstance(fname, (str, os.PathLike)):  # not the animation writer's in-memory frames
+            saved[Path(fname)] = (fig, kwargs.get("dpi"))
+        return savefig(fig, fname, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", recording)
+    return saved
+
+
+def assert_figure_shows(fig, shown):
+    """The figure has the axes `shown` lists, and every line and 2-D line collection lies inside
+    its axes' view, with finite data."""
+    assert [(ax.name, len(ax.lines), [type(c).__name__ for c in ax.collections]) for ax in fig.axes] == shown
+    for ax in fig.axes:
+        limits = [ax.get_xlim(), ax.get_ylim()] + ([ax.get_zlim()] if ax.name == "3d" else [])
+        data = [np.column_stack(line.get_data_3d() if ax.name == "3d" else line.get_data()) for line in ax.lines]
+        if ax.name != "3d":
+            data += [np.concatenate(c.get_segments()) for c in ax.collections
+                     if type(c).__name__ == "LineCollection" and c.get_segments() and ax.get_label() != "<colorbar>"]
+        for points in data:
+            points = points[~np.isnan(points).any(axis=1)].astype(float)
+            assert len(points) and np.all(np.isfinite(points))
+            lo, hi = np.array(limits).min(axis=1), np.array(limits).max(axis=1)
+            assert np.all(points >= lo - 1e-12) and np.all(points <= hi + 1e-12)
+
+
 @pytest.mark.parametrize("name", FAST + [pytest.param(n, marks=pytest.mark.slow) for n in SLOW])
-def test_example_draws_its_figures(name, tmp_path):
+def test_example_draws_its_figures(name, tmp_path, saved_figures):
+    """Every figure an example returns is written to its output directory: a PNG image of the
+    figure's size, showing the axes and data of `SHOWN` (an animation: a GIF of several frames)."""
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
     result = load(name).main(tmp_path, tiny=True)
-    paths = result if isinstance(result, list) else [result]
+    paths = [Path(p) for p in (result if isinstance(result, list) else [result])]
     for path in paths:
-        assert Path(path).parent == tmp_path and Path(path).stat().st_size > 2000
+        assert path.parent == tmp_path and path.is_file()
+        if path.suffix == ".gif":
+            with Image.open(path) as gif:
+                assert gif.format == "GIF" and gif.n_frames > 1
+            continue
+        fig, dpi = saved_figures[path]
+        width, height = np.round(fig.get_size_inches() * dpi).astype(int)
+        assert plt.imread(path).shape == (height, width, 4)
+        assert_figure_shows(fig, SHOWN[path.name])
+
+
+def test_the_figure_check_rejects_what_is_not_shown():
+    """Negative controls for `assert_figure_shows`: a line outside the view, a missing line."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0.0, 1.0, 2.0], [0.0, 1.0, 0.0])
+    assert_figure_shows(fig, [("rectilinear", 1, [])])
+    with pytest.raises(AssertionError):
+        assert_figure_shows(fig, [("rectilinear", 2, [])])
+    ax.set_xlim(0.0, 1.5)  # the last vertex is cut off
+    with pytest.raises(AssertionError):
+        assert_figure_shows(fig, [("rectilinear", 1, [])])
+    plt.close(fig)
 
 
 def test_custom_energy_finds_the_regular_polygon():

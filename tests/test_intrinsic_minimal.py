@@ -81,15 +81,55 @@ def test_minimal_surface_bad_boundary_index():
         area.minimal_surface_delaunay(V, F, [0, 999])
 
 
-def test_plot_before_after_writes_png(tmp_path):
+def _segment_set(segments) -> set:
+    """Segments as a set of unordered pairs of points (rounded), to compare drawings with edges."""
+    return {tuple(sorted(map(tuple, np.round(np.asarray(s), 12)))) for s in segments}
+
+
+def assert_panel_shows(ax, tri, V):
+    """One panel of `before_after`: the edges of `tri` at the positions V, the Delaunay ones grey
+    and thin, the non-Delaunay ones (Prop 7.9) red and thick and counted in the legend, the
+    vertices as dots, all inside the view."""
+    ok = np.asarray(dg.intrinsic.delaunay_edges(tri))
+    chords = V[tri.edges][:, :, :2]
+    grey, red = ax.collections
+    assert _segment_set(grey.get_segments()) == _segment_set(chords[ok])
+    assert _segment_set(red.get_segments()) == _segment_set(chords[~ok])
+    assert grey.get_linewidth()[0] < red.get_linewidth()[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [f"non-Delaunay ({int((~ok).sum())})"]
+    (dots,) = ax.lines
+    np.testing.assert_array_equal(np.column_stack(dots.get_data()), V[:, :2])
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert x0 <= V[:, 0].min() and x1 >= V[:, 0].max() and y0 <= V[:, 1].min() and y1 >= V[:, 1].max()
+
+
+def test_plot_before_after_shows_both_triangulations(tmp_path):
+    """Two 2-D panels: the start triangulation with its non-Delaunay edges highlighted, and the
+    flipped one with none; the saved PNG is the 10 × 5 in figure at 120 dpi."""
+    import matplotlib.pyplot as plt
+
     rng = np.random.default_rng(3)
     P = rng.uniform(0, 1, (60, 2))
     F = Delaunay(P * np.array([1.0, 6.0])).simplices  # not Delaunay for the true metric
     u, w = P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]
     cw = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0] < 0
     F[cw] = F[cw][:, [0, 2, 1]]
-    path = tmp_path / "flips.png"
-    result = iplot.before_after(np.column_stack([P, np.zeros(60)]), F, path)
+    V = np.column_stack([P, np.zeros(60)])
+    result, fig = iplot.before_after(V, F)
     assert result.n_flips > 0 and dg.intrinsic.is_delaunay(result)
-    assert path.exists() and path.stat().st_size > 10_000
-    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    start = dg.intrinsic.from_mesh(V, F)
+    before, after = fig.axes
+    assert [ax.name for ax in fig.axes] == ["rectilinear", "rectilinear"]
+    assert [ax.get_title() for ax in fig.axes] == ["start triangulation", f"after {result.n_flips} flips"]
+    assert_panel_shows(before, start, V)
+    assert_panel_shows(after, result.triangulation, V)
+    assert len(after.collections[1].get_segments()) == 0 < len(before.collections[1].get_segments())
+    with pytest.raises(AssertionError):  # negative control: the start panel is not the flipped triangulation
+        assert_panel_shows(before, result.triangulation, V)
+    plt.close(fig)
+
+    path = tmp_path / "flips.png"
+    open_figures = len(plt.get_fignums())
+    saved = iplot.before_after(V, F, path)  # with a path: the flip result, the figure written and closed
+    assert saved.n_flips == result.n_flips and len(plt.get_fignums()) == open_figures
+    assert plt.imread(path).shape == (600, 1200, 4)

@@ -150,11 +150,49 @@ def test_bad_meshes_name_the_offender():
     assert not np.isnan(V).any()  # the caller's array is untouched
 
 
-def test_plots_are_written(tmp_path):
+def assert_harmonic_plot_shows(fig, V, F, f):
+    """`plot_laplace.harmonic_function`'s figure of a planar mesh: one 2-D axes with f shaded over
+    the triangles and its contour lines, the mesh's edges drawn once each, and a colour bar of f's
+    range labelled "f"; the view covers the mesh."""
+    ax, bar = fig.axes
+    assert ax.name == "rectilinear" and bar.get_label() == "<colorbar>"
+    shading, contours = ax.collections
+    assert type(shading).__name__ == "TriMesh" and type(contours).__name__ == "TriContourSet"
+    np.testing.assert_allclose(shading.get_array(), f, rtol=1e-12, atol=0)
+    assert shading.get_clim() == (f.min(), f.max()) and shading.colorbar.ax is bar
+    assert bar.get_ylabel() == "f" and bar.get_ylim() == (f.min(), f.max())
+    levels = contours.levels
+    assert len(levels) >= 10 and levels[0] <= f.min() and levels[-1] >= f.max()
+    edges, _ = ax.lines  # triplot: the edges (NaN-separated), then the (unmarked) vertices
+    assert len(edges.get_xdata()) == 3 * len(dg.mesh.edges(F))
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert x0 <= V[:, 0].min() and x1 >= V[:, 0].max() and y0 <= V[:, 1].min() and y1 >= V[:, 1].max()
+
+
+def test_harmonic_function_plot_shows_the_solution(tmp_path):
+    import matplotlib.pyplot as plt
+
     from ddgjax.plot import laplace as plot_laplace
 
     V, F, b = square_grid(8)
     u = np.exp(V[:, 0]) * np.sin(V[:, 1])
     f = dirichlet.cotan_sparse(V, F, b, u[b])
+    fig = plot_laplace.harmonic_function(V, F, f, title="dDBVP")
+    assert_harmonic_plot_shows(fig, V, F, f)
+    assert fig.axes[0].get_title() == "dDBVP"
+    with pytest.raises(AssertionError):  # negative control: the smooth u differs from f inside
+        assert_harmonic_plot_shows(fig, V, F, u)
+    plt.close(fig)
+    # a curved surface is drawn in 3-D, one polygon per triangle
+    W = V.copy()
+    W[:, 2] = 0.3 * f
+    fig = plot_laplace.harmonic_function(W, F, f)
+    ax, bar = fig.axes
+    assert ax.name == "3d" and bar.get_label() == "<colorbar>"
+    assert bar.get_ylim() == pytest.approx((-f[F].mean(axis=1).max(), f[F].mean(axis=1).max()), rel=1e-12)
+    fig.canvas.draw()
+    assert len(ax.collections[0].get_paths()) == len(F)
+    plt.close(fig)
     path = plot_laplace.harmonic_function(V, F, f, tmp_path / "harmonic.png")
-    assert path.exists() and path.stat().st_size > 5000
+    assert path == tmp_path / "harmonic.png"
+    assert plt.imread(path).shape == (495, 550, 4)  # 5 × 4.5 in at 110 dpi

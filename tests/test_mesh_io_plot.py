@@ -43,8 +43,48 @@ def test_face_values_average_the_curvature():
         plot_surface.face_values(V, F, np.ones(5))
 
 
-def test_surface_plot_writes_png(tmp_path):
+def _rows(colours) -> list:
+    """RGBA rows as a sorted list: the colours drawn, whatever order the faces are painted in."""
+    return sorted(map(tuple, np.round(np.asarray(colours), 12)))
+
+
+def assert_surface_shows(fig, V, F, color_by):
+    """`plot_surface.surface`'s figure of (V, F): 3-D axes and a colour bar; one polygon per face,
+    coloured by `face_values(V, F, color_by)` on coolwarm symmetric about 0; the view a cube
+    around the vertices."""
+    import matplotlib
+
+    ax, bar = fig.axes
+    assert ax.name == "3d" and bar.get_label() == "<colorbar>"
+    (faces,) = ax.collections
+    assert type(faces).__name__ == "Poly3DCollection"
+    values = plot_surface.face_values(V, F, color_by)
+    scale = np.max(np.abs(values))
+    assert bar.get_ylim() == pytest.approx((-scale, scale), rel=1e-12)
+    assert bar.get_ylabel() == (color_by if isinstance(color_by, str) else "value")
+    expected = matplotlib.colormaps["coolwarm"]((values + scale) / (2 * scale))
+    assert _rows(faces.get_facecolor()) == _rows(expected)
+    fig.canvas.draw()  # the polygons are projected when drawn
+    assert len(faces.get_paths()) == len(F)
+    limits = np.array([ax.get_xlim(), ax.get_ylim(), ax.get_zlim()])
+    assert np.all(limits[:, 0] <= V.min(axis=0)) and np.all(limits[:, 1] >= V.max(axis=0))
+    np.testing.assert_allclose(np.ptp(limits, axis=1), np.max(np.ptp(V, axis=0)), rtol=1e-12)
+
+
+def test_surface_plot_shows_the_faces_coloured_by_curvature(tmp_path):
+    import matplotlib.pyplot as plt
+
     V, F = mesh.torus(10, 6)
+    fig = plot_surface.surface(V, F, color_by="mean_curvature", title="torus")
+    assert_surface_shows(fig, V, F, "mean_curvature")
+    assert fig.axes[0].get_title() == "torus"
+    with pytest.raises(AssertionError):  # negative control: the colours are not the angle defect's
+        assert_surface_shows(fig, V, F, "angle_defect")
+    plt.close(fig)
+    fig = plot_surface.surface(*mesh.torus(8, 5), color_by="mean_curvature")
+    with pytest.raises(AssertionError):  # negative control: another torus has other faces
+        assert_surface_shows(fig, V, F, "mean_curvature")
+    plt.close(fig)
     path = plot_surface.surface(V, F, tmp_path / "torus.png", color_by="mean_curvature")
-    with open(path, "rb") as fh:
-        assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
+    assert path == tmp_path / "torus.png"
+    assert plt.imread(path).shape == (495, 550, 4)  # 5 × 4.5 in at 110 dpi

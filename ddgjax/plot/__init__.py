@@ -5,6 +5,11 @@
 - laplace: `harmonic_function`, `minimal_surface` (Sec 6);
 - intrinsic: `triangulation`, `before_after` (non-Delaunay edges highlighted, Sec 7);
 - `save_figure`: the one place that lays out, writes and closes a figure.
+
+Every drawing function returns the matplotlib Figure when `path` is None, and when `path` is
+given saves the figure there (by `save_figure`), closes it and returns `path`.  The exceptions:
+`animate_spin_chain` always writes its `path`; `intrinsic.before_after` returns its flip result,
+with the figure beside it, `(result, fig)`, when `path` is None.
 """
 
 from . import intrinsic as intrinsic

@@ -2,7 +2,8 @@
 
 Edges are drawn as straight segments between the vertex positions: exact for flat surfaces in
 the plane, chords of the geodesic edges otherwise.  matplotlib (Agg) is imported inside the
-functions, never when ddgjax is imported.
+functions, never when ddgjax is imported.  `triangulation` returns the figure, or, when `path` is
+given, saves it there, closes it and returns `path`; `before_after` returns the flip result too.
 """
 
 from __future__ import annotations
@@ -18,10 +19,15 @@ __all__ = ["before_after", "triangulation"]
 
 
 
-def triangulation(tri: Triangulation, V, ax=None, *, title: str | None = None, tol: float = DELAUNAY_TOL):
-    """Draw the edges of `tri` at the positions `V` (nv, 2) or (nv, 3, first two coordinates):
-    Delaunay edges thin and grey, non-Delaunay edges (Prop 7.9) thick and red.  Returns the
-    axes."""
+def triangulation(tri: Triangulation, V, ax=None, *, path=None, title: str | None = None,
+                  tol: float = DELAUNAY_TOL):
+    """Draw the edges of `tri` at the positions `V` (nv, 2) or (nv, 3, first two coordinates) on
+    2-D axes (`ax`, else a new figure's): two line collections, the Delaunay edges thin and grey,
+    the non-Delaunay edges (Prop 7.9) thick and red, labelled with their count in the legend, and
+    the vertices as dots.
+
+    Returns the figure, or `path` after saving there.
+    """
     V = np.asarray(V, dtype=np.float64)
     if V.ndim != 2 or V.shape[0] != tri.n_vertices or V.shape[1] < 2:
         raise ShapeError(f"V must have shape ({tri.n_vertices}, 2 or 3), got {V.shape}")
@@ -40,18 +46,24 @@ def triangulation(tri: Triangulation, V, ax=None, *, title: str | None = None, t
     ax.legend(loc="upper right", fontsize=8)
     if title:
         ax.set_title(title)
-    return ax
+    return ax.figure if path is None else save_figure(ax.figure, path, dpi=120)
 
 
-def before_after(V, F, path, *, tol: float = DELAUNAY_TOL):
-    """Two panels: the triangulation (V, F) and its intrinsic Delaunay triangulation after edge
-    flipping (Fig 7.13), non-Delaunay edges highlighted; saved to `path` (PNG).  Returns the
-    `FlipResult`."""
+def before_after(V, F, path=None, *, tol: float = DELAUNAY_TOL):
+    """Flip the triangulation (V, F) to its intrinsic Delaunay triangulation (Fig 7.13) and draw
+    both: two 2-D axes, "start triangulation" and "after k flips", each by `triangulation`
+    (non-Delaunay edges highlighted).
+
+    Returns the `FlipResult` after saving the figure to `path` (PNG), or, when `path` is None,
+    the pair `(FlipResult, figure)`.
+    """
     plt = pyplot()
     tri = from_mesh(V, F)
     result = flip_to_delaunay(tri, tol=tol)
     fig, axes = plt.subplots(1, 2, figsize=(10, 5))
     triangulation(tri, V, axes[0], title="start triangulation", tol=tol)
     triangulation(result.triangulation, V, axes[1], title=f"after {result.n_flips} flips", tol=tol)
+    if path is None:
+        return result, fig
     save_figure(fig, path, dpi=120)
     return result

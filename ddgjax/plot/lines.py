@@ -2,7 +2,7 @@
 
 matplotlib is imported and switched to the non-interactive Agg backend inside each function,
 never when ddgjax is imported.  Each function returns the figure, or, when `path` is given,
-saves it there, closes it and returns `path`.
+saves it there, closes it and returns `path`; `animate_spin_chain` always writes its `path`.
 """
 
 from __future__ import annotations
@@ -82,9 +82,13 @@ def curves(
     return _finish(ax, path)
 
 
-def convergence(table: ConvergenceTable, path, *, title: str | None = None):
-    """Log-log plot of a `ddgjax.limits.ConvergenceTable`: the errors against n and a reference
-    line of slope −p, p the fitted order; saves `path` and returns it (= `table.plot(path)`)."""
+def convergence(table: ConvergenceTable, path=None, *, title: str | None = None):
+    """Log-log plot of a `ddgjax.limits.ConvergenceTable`: one 2-D axes with the errors against n
+    (points joined, labelled `table.label`) and a dashed reference line of slope −p through the
+    first error, p the fitted order; a legend, and the title `title` or "fitted order p".
+
+    Returns the figure, or `path` after saving there (= `table.plot(path)`).
+    """
     fig, ax = pyplot().subplots(figsize=(4.5, 3.5))
     ax.loglog(table.ns, table.errors, "o-", label=table.label)
     reference = table.errors[0] * (table.ns / table.ns[0]) ** (-table.fitted_order)
@@ -93,11 +97,14 @@ def convergence(table: ConvergenceTable, path, *, title: str | None = None):
     ax.set_ylabel(table.label)
     ax.set_title(title or f"fitted order {table.fitted_order:.2f}")
     ax.legend()
-    return save_figure(fig, path)
+    return fig if path is None else save_figure(fig, path)
 
 
 def spin_chain(S, ax=None, *, path=None, title: str | None = None):
-    """A closed chain of spins (N, 3) drawn as arrows standing on a ring in the plane z = 0."""
+    """A closed chain of spins (N, 3) drawn as arrows standing on a ring in the plane z = 0.
+
+    Returns the figure, or `path` after saving there.
+    """
     S = np.asarray(S)
     ax = _axes(ax, 3)
     angle = 2 * np.pi * np.arange(len(S)) / len(S)
@@ -111,8 +118,8 @@ def spin_chain(S, ax=None, *, path=None, title: str | None = None):
 
 
 def animate_spin_chain(Ss, path, *, times=None, fps: int = 10):
-    """An animated GIF of a spin chain evolving (frames Ss: (frames, N, 3)); matplotlib's Pillow
-    writer.  Returns `path`."""
+    """An animated GIF of a spin chain evolving (frames Ss: (frames, N, 3)), one `spin_chain`
+    per frame; matplotlib's Pillow writer.  Writes `path` (required) and returns it."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
     plt = pyplot()

@@ -1,6 +1,7 @@
 """Figures of polyhedral surfaces coloured by curvature (matplotlib, Agg backend).
 
-matplotlib is imported inside the function, never when ddgjax is imported.
+matplotlib is imported inside the function, never when ddgjax is imported.  `surface` returns
+the figure, or, when `path` is given, saves it there, closes it and returns `path`.
 """
 
 from __future__ import annotations
@@ -42,10 +43,13 @@ def face_values(V, F, color_by="angle_defect") -> np.ndarray:
     return values
 
 
-def surface(V, F, path=None, *, color_by="angle_defect", cmap="coolwarm", title=None):
-    """Draw the faces of (V, F) with a Poly3DCollection coloured by `face_values(V, F, color_by)`
-    on a colour scale symmetric about 0 (elliptic / hyperbolic in different hues), with a colour bar.
+def surface(V, F, path=None, *, color_by="angle_defect", cmap="coolwarm", title=None, label=None, ax=None):
+    """Draw the faces of (V, F) with a Poly3DCollection, one polygon per face, coloured by
+    `face_values(V, F, color_by)` on a colour scale symmetric about 0 (elliptic / hyperbolic in
+    different hues), with a colour bar labelled `label` (default: the name `color_by`, or "value"
+    for an array); the axes are a cube around the vertices' bounding box.
 
+    `ax`: 3-D axes to draw into (the colour bar goes beside them), else a new figure's.
     Returns the figure, or `path` after saving there (PNG or any matplotlib format).
     """
     import matplotlib
@@ -58,15 +62,17 @@ def surface(V, F, path=None, *, color_by="angle_defect", cmap="coolwarm", title=
     scale = max(float(np.max(np.abs(values))), 1e-300)
     norm = matplotlib.colors.Normalize(-scale, scale)
     colormap = pyplot().get_cmap(cmap)
-    fig = pyplot().figure(figsize=(5.0, 4.5))
-    ax = fig.add_subplot(projection="3d")
+    if ax is None:
+        ax = pyplot().figure(figsize=(5.0, 4.5)).add_subplot(projection="3d")
+    fig = ax.figure
     ax.add_collection3d(Poly3DCollection(polygons, facecolors=colormap(norm(values)), edgecolors="k", linewidths=0.2))
     lo, hi = V.min(axis=0), V.max(axis=0)
     centre, radius = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 1e-12)
     ax.set(xlim=(centre[0] - radius, centre[0] + radius), ylim=(centre[1] - radius, centre[1] + radius),
            zlim=(centre[2] - radius, centre[2] + radius))
-    label = color_by if isinstance(color_by, str) else "value"
-    fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=colormap), ax=ax, shrink=0.7, label=label)
+    if label is None:
+        label = color_by if isinstance(color_by, str) else "value"
+    fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=colormap), ax=ax, shrink=0.7, pad=0.1, label=label)
     if title:
         ax.set_title(title)
     if path is None:
