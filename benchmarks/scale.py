@@ -1,5 +1,6 @@
 """Scaling of `solve` (issue 9): the clamped elastica at 10³–10⁵ edges and the simplicial-area
-Newton solve with fixed boundary up to ~10⁵ vertices, sparse path (declared locality, KLU)
+Newton solve with fixed boundary up to ~10⁵ vertices, sparse path (declared locality: KLU on the
+chains, the fill-reducing `SparseDirect` on the meshes, with KLU beside it there up to `--klu-max`)
 side by side with the dense path and the Krylov path (`method="krylov"`: for the elastica GMRES
 preconditioned by the block-tridiagonal solve, at every size; for the area, a 2-D mesh, MINRES
 on the tangent space with a Jacobi metric, up to `--krylov-max`) where they fit.
@@ -19,7 +20,7 @@ Problems:
   step), then 5 Pinkall–Polthier iterations (`area.minimal_surface(method="cotan")`), then
   `energies.area.simplicial(V, F, boundary)`, tol 1e-9 (the area gradient, max-norm).
 
-    python benchmarks/scale.py [--quick] [--repeats 3] [--dense-max 3000] [--krylov-max 5000] [--big-area]
+    python benchmarks/scale.py [--quick] [--repeats 3] [--dense-max 3000] [--krylov-max 5000] [--klu-max 40000] [--big-area]
 
 The machine may be shared: when the load average exceeds the core count, timings are flagged.
 """
@@ -38,7 +39,7 @@ import numpy as np
 
 import ddgjax as dg  # noqa: F401  (float64)
 from energies import area, elastica
-from solvers import solve
+from solvers import KLU, solve
 
 
 def peak_mb() -> float:
@@ -100,13 +101,16 @@ def area_problem(k: int, cotan_steps: int = 5):
 
 
 def measure(problem, method: str, repeats: int, tol: float) -> dict:
+    """Compile and per-step time of `solve(problem, method=...)`; `method` may also name a
+    linear-solver object (`"klu"`: `KLU()`, to compare with `"sparse"` on meshes)."""
+    kw = {"linear_solver": KLU()} if method == "klu" else {"method": method}
     t0 = time.perf_counter()
-    sol = solve(problem, method=method, tol=tol, throw=False)
+    sol = solve(problem, tol=tol, throw=False, **kw)
     first = time.perf_counter() - t0
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        sol = solve(problem, method=method, tol=tol, throw=False)
+        sol = solve(problem, tol=tol, throw=False, **kw)
         sol.x.block_until_ready()
         times.append(time.perf_counter() - t0)
     median = statistics.median(times)
@@ -115,6 +119,26 @@ def measure(problem, method: str, repeats: int, tol: float) -> dict:
         "compile": first - median, "solve": median, "per_step": median / steps, "steps": int(sol.steps),
         "residual": float(sol.residual), "converged": bool(sol.converged), "peak": peak_mb(),
     }
+
+
+def splu_block_laplacian(k: int, repeats: int) -> float:
+    """Median seconds of scipy's `splu` of the 3×3-block cotan Laplacian (`kron(L_interior, I₃)`)
+    of the k×k saddle grid: the reference a sparse direct Newton step is compared with."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from ddgjax.laplace import cotan_laplacian
+
+    V, F, b = saddle_grid(k)
+    interior = np.setdiff1d(np.arange(len(V)), b)
+    L = cotan_laplacian(V, F)[interior][:, interior]
+    B = sp.kron(L, sp.eye(3)).tocsc()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        spla.splu(B)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
 
 
 def row(name, n, size, method, r) -> str:
@@ -130,15 +154,16 @@ def main():
     ap.add_argument("--krylov-max", type=int, default=5000, help="largest N for the Krylov path on meshes (Jacobi-"
                     "preconditioned: its iteration count grows with the condition number)")
     ap.add_argument("--tol", type=float, default=1e-9)
+    ap.add_argument("--klu-max", type=int, default=40_000, help="largest N for KLU on meshes, beside the default sparse path")
     ap.add_argument("--big-area", action="store_true",
-                    help="add the 316² ≈ 10⁵-vertex area solve (KLU fill on the 2-D mesh: > 15 min, > 6 GB on 2 cores)")
+                    help="add the 316² ≈ 10⁵-vertex area solve")
     args = ap.parse_args()
 
     load = os.getloadavg()[0]
     cores = os.cpu_count() or 1
     print(f"cores: {cores}, load average: {load:.1f}" + ("  (LOADED MACHINE: timings are inflated)" if load > cores else ""))
     el_sizes = [100, 1000] if args.quick else [100, 300, 1000, 10_000, 100_000]
-    grid_sizes = ([10, 30] if args.quick else [10, 30, 100]) + ([316] if args.big_area else [])
+    grid_sizes = [10, 32] if args.quick else [32, 100, 178] + ([316] if args.big_area else [])
     results = []
     print("\n| problem | n | N | method | compile s | solve s | s/step | steps | residual | peak MB |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -147,9 +172,10 @@ def main():
         problem = make(n)
         size = int(np.sum(~np.asarray(problem.fixed))) + problem.n_constraints
         repeats = args.repeats if size < 100_000 else 1
-        for method in ("sparse", "dense", "krylov"):
+        for method in ("sparse", "klu", "dense", "krylov"):
             krylov_max = size if name == "elastica" else args.krylov_max  # a chain: block-tridiagonal preconditioner
-            if size > {"sparse": size, "dense": args.dense_max, "krylov": krylov_max}[method]:
+            limit = {"sparse": size, "klu": args.klu_max if name == "area" else -1, "dense": args.dense_max, "krylov": krylov_max}
+            if size > limit[method]:
                 continue
             r = measure(problem, method, repeats, args.tol)
             results.append((name, n, method, r))
@@ -171,9 +197,23 @@ def main():
         print(f"{'PASS' if p <= 1.2 else 'FAIL'}: exponent {p:.2f} ≤ 1.2")
     ar = [(n, r) for name, n, m, r in results if name == "area" and m == "sparse"]
     if ar:
+        print("\n| area vertices | sparse s/step | splu of the 3×3-block cotan Laplacian s | ratio |")
+        print("|---|---|---|---|")
+        for n, r in ar:
+            ref = splu_block_laplacian(int(round(n**0.5)), args.repeats)
+            r["splu"] = ref
+            print(f"| {n} | {r['per_step']:.4f} | {ref:.4f} | {r['per_step'] / ref:.2f} |", flush=True)
+        big = [(n, r) for n, r in ar if n >= 1000]
+        if len(big) >= 2:
+            p = np.polyfit(np.log([n for n, _ in big]), np.log([r["per_step"] for _, r in big]), 1)[0]
+            print(f"{'PASS' if p <= 1.3 else 'FAIL'}: fitted exponent of s/step vs vertices (area, sparse, n ≥ 10³): {p:.2f} ≤ 1.3")
+        near = min(ar, key=lambda item: abs(np.log(item[0] / 1e4)))
+        n, r = near
+        print(f"{'PASS' if r['per_step'] <= 2 * r['splu'] else 'FAIL'}: area Newton at {n} vertices {r['per_step']:.3f} s/step "
+              f"≤ 2 × splu {r['splu']:.3f} s")
         n, r = ar[-1]
         print(f"{'PASS' if r['converged'] else 'FAIL'}: area Newton solve with {n} vertices converged "
-              f"(residual {r['residual']:.1e}, {r['steps']} steps)")
+              f"(residual {r['residual']:.1e}, {r['steps']} steps, {r['solve']:.1f} s after compile, peak {r['peak']:.0f} MB)")
     if load > cores:
         print(f"note: load average {load:.1f} > {cores} cores during the run: other processes share the CPU")
 

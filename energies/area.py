@@ -53,7 +53,9 @@ from .dirichlet import dirichlet_solve
 __all__ = ["METHODS", "face_area", "harmonic_iteration", "interior_residual", "minimal_surface",
            "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial"]
 
-METHODS = ("cotan", "newton", "delaunay")
+METHODS = ("auto", "cotan", "newton", "delaunay")
+LOOSE_TOL = 1e-4  # the "auto" method's switch from Fig 6.5 to Newton, relative to the boundary's size
+LOOSE_ITER = 200
 
 
 def face_area(P: Float[Array, "3 3"], params=None) -> Float[Array, ""]:
@@ -213,28 +215,77 @@ def _newton(V, F, b, tol, max_iter, solve_method="auto", **kwargs):
     return np.asarray(sol.x), F, info
 
 
-def minimal_surface(V, F, boundary=None, *, method: str = "cotan", tol: float = 1e-10,
+PINCH = 1e-8  # a face whose area falls below this fraction of the mean has collapsed
+
+
+def _pinched(V, F) -> int | None:
+    """The first face of (V, F) whose area collapsed (below `PINCH` × the mean), or None."""
+    areas = np.asarray(face_areas(V, F)) if np.all(np.isfinite(V)) else np.zeros(len(F))
+    small = np.flatnonzero(~(areas > PINCH * max(float(np.mean(areas)), 1e-300)))
+    return int(small[0]) if small.size else None
+
+
+def _pinch_error(V, F, where: str, cause=None) -> ConvergenceError:
+    face = _pinched(V, F)
+    what = f"face {face} collapsed" if face is not None else f"the next iterate degenerated: {cause}"
+    return ConvergenceError(
+        f"minimal_surface: the surface pinched during {where} ({what}): there is no minimal "
+        "surface of this topology near the start spanning this boundary (e.g. two coaxial circles too far "
+        "apart for a catenoid); the input mesh is not at fault", residual=float("nan"), steps=0)
+
+
+def _auto(V, F, boundary, tol, max_iter):
+    """Fig 6.5 to a loose tolerance, then a minimisation by Newton with inertia correction
+    (`solvers.minimize`): a local minimum of the area, to `tol`."""
+    from solvers import minimize
+
+    V0, F, b = _checked(V, F, boundary)
+    loose = max(tol, LOOSE_TOL * float(np.ptp(V0[b], axis=0).max() if b.size else 1.0))
+    V1, F, pp = harmonic_iteration(V0, F, b, flip=False, tol=loose, max_iter=min(LOOSE_ITER, max_iter))
+    if pp["breakdown"] is not None or _pinched(V1, F) is not None:
+        raise _pinch_error(V1, F, f"the Pinkall–Polthier iteration (step {pp['iterations']})", pp["breakdown"])
+    sol = minimize(simplicial(V1, F, b), tol=tol, max_steps=max(max_iter - pp["iterations"], 0), throw=False)
+    V2 = np.asarray(sol.x)
+    if _pinched(V2, F) is not None:
+        raise _pinch_error(V2, F, "Newton's minimisation")
+    history = np.concatenate([pp["history"][:-1], np.asarray(sol.history)])
+    info = {"method": "auto", "iterations": len(history) - 1, "history": history, "residual": float(history[-1]),
+            "area": np.concatenate([pp["area"], [float(sol.energy)]]), "converged": bool(sol.converged),
+            "cotan_iterations": pp["iterations"], "newton_iterations": int(sol.steps), "minimum": bool(sol.converged)}
+    return V2, F, info
+
+
+def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1e-10,
                     max_iter: int = 1000, throw: bool = True, **kwargs):
     """A simplicial minimal surface spanned by the fixed `boundary` vertices of (V, F), started
     from V: `(V_min, F, info)`.
 
-    **Arguments:** `method` `"cotan"` (Fig 6.5, Pinkall–Polthier), `"delaunay"` (Fig 7.23, a
-    minimal surface in the narrow sense; `delaunay_tol=` the flips' tie tolerance) or `"newton"`
-    (`solvers.solve` on `simplicial`; `solve_method=` is solve's `method`, other `kwargs` go to
-    `solve`); `tol`: stop when the max-norm of the area gradient at the interior vertices is
-    `<= tol` (Fig 6.5 gets to ~1e-5 fast and then creeps: module docstring); `max_iter`:
-    iterations (Newton steps); `throw`: raise `ConvergenceError` if not converged.
+    **Arguments:** `method` `"auto"` (default: Fig 6.5 to a loose tolerance, 1e-4 of the
+    boundary's size, then Newton's method with inertia correction, `solvers.minimize`: a local
+    *minimum* of the area, never a saddle, converged to `tol`), `"cotan"` (Fig 6.5,
+    Pinkall–Polthier alone: fast to ~1e-5, then creeping), `"delaunay"` (Fig 7.23, a minimal
+    surface in the narrow sense; `delaunay_tol=` the flips' tie tolerance) or `"newton"`
+    (`solvers.solve` on `simplicial`, a critical point of any index; `solve_method=` is solve's
+    `method`, other `kwargs` go to `solve`); `tol`: stop when the max-norm of the area gradient
+    at the interior vertices is `<= tol`; `max_iter`: iterations (both phases of `"auto"`
+    together); `throw`: raise `ConvergenceError` if not converged.
 
     **Returns:** `V_min` (nv, 3), `F` (for `"delaunay"` the final triangulation), and `info` as
-    `harmonic_iteration` (Newton: `method`, `iterations`, `history`, `area`, `residual`,
-    `converged`).
+    `harmonic_iteration` (Newton and auto: `method`, `iterations`, `history`, `area`, `residual`,
+    `converged`; auto also `cotan_iterations`, `newton_iterations` and `minimum`: no negative
+    eigenvalue of the area Hessian on the free vertices).
 
     **Raises:** `InvalidInputError` (unknown method or option), the errors of `simplicial`,
-    `ConvergenceError` (not converged, or an iterate degenerated).
+    `ConvergenceError` (not converged, an iterate degenerated, or, for `"auto"`, the surface
+    pinched: no minimal surface near the start).
     """
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
-    if method == "newton":
+    if method == "auto":
+        if kwargs:
+            raise InvalidInputError(f"method='auto' takes no further options, got {sorted(kwargs)}")
+        V_min, F, info = _auto(V, F, boundary, float(tol), int(max_iter))
+    elif method == "newton":
         V, F, b = _checked(V, F, boundary)
         V_min, F, info = _newton(V, F, b, float(tol), int(max_iter), **kwargs)
     else:

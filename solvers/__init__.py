@@ -1,7 +1,7 @@
 """ddgjax.solvers: the generic constrained critical-point solver.
 
-`solve(problem)` runs globalised Newton on the KKT system of a `ddgjax.Problem` with dense or
-sparse (declared locality) linear algebra, an optional first-order phase, and implicit
+`solve(problem)` runs globalised Newton on the KKT system of a `ddgjax.Problem` with a
+`LinearSolver` (dense LU, KLU, a fill-reducing sparse direct solver, Krylov), an optional first-order phase, and implicit
 differentiation; `solve_batch(problem, params_batch, devices=...)` solves a batch of
 parameters in one call, vectorised and sharded over devices.  This package knows nothing of curves or meshes.
 """
@@ -9,7 +9,13 @@ parameters in one call, vectorised and sharded over devices.  This package knows
 import ddgjax as _ddgjax  # noqa: F401  (switches on float64 before anything is traced)
 
 from ._batch import solve_batch as solve_batch
+from ._dense import DenseLU as DenseLU
+from ._direct import SparseDirect as SparseDirect
+from ._klu import KLU as KLU
+from ._krylov import Krylov as Krylov
+from ._linear import LinearSolver as LinearSolver
+from ._minimize import minimize as minimize
 from ._solve import Solution as Solution
 from ._solve import solve as solve
 
-__all__ = ["solve", "solve_batch", "Solution"]
+__all__ = ["solve", "minimize", "solve_batch", "Solution", "LinearSolver", "DenseLU", "KLU", "SparseDirect", "Krylov"]

@@ -52,6 +52,7 @@ def solve_batch(
     *,
     devices=None,
     method: str = "auto",
+    linear_solver=None,
     tol: float = 1e-10,
     max_steps: int = 100,
     throw: bool = True,
@@ -76,7 +77,7 @@ def solve_batch(
     - `params_batch`: a pytree like `problem.params` whose leaves have a leading batch axis,
       or, for dict parameters, a dict of only the keys that vary (e.g. `{"chord": (B, 3)}`).
     - `devices`: `None` (default device), `"all"` (`jax.devices()`), or a list of devices.
-    - `method`, `tol`, `max_steps`: as in `solve`.
+    - `method`, `linear_solver`, `tol`, `max_steps`: as in `solve`.
     - `throw`: raise `ConvergenceError` naming the first member that did not converge.
 
     **Returns:** a `Solution` whose leaves have a leading batch axis (sharded over `devices`).
@@ -100,7 +101,7 @@ def solve_batch(
     size = _batch_size(batched)
 
     def one(p):
-        return solve(problem.with_params(merge(p)), method=method, tol=tol, max_steps=max_steps, throw=False)
+        return solve(problem.with_params(merge(p)), method=method, linear_solver=linear_solver, tol=tol, max_steps=max_steps, throw=False)
 
     if devices is None:
         sol = jax.jit(jax.vmap(one))(batched)

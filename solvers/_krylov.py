@@ -58,8 +58,8 @@ from . import _banded as banded
 from ._banded import Chain, chain_arrays, chain_structure
 from ._cache import derived
 from ._kkt import KKT
-from ._linear import _Algebra, _regularisation
-from ._sparse import PatternKey, SparsePattern, index_arrays, kkt_values
+from ._linear import LinearSolver, regularisation
+from ._sparse import PatternKey, SparsePattern, cached_pattern, index_arrays, kkt_values
 
 RTOL = 1e-12
 CHAIN_RESTART, CHAIN_CYCLES = 10, 2  # GMRES with the block-tridiagonal preconditioner (border rank ≤ 2·3 for a chord)
@@ -204,10 +204,11 @@ def _autodiff_linearisation(kkt: KKT, w, identity_hessian: bool) -> Linearisatio
 
 
 @jax.tree_util.register_pytree_node_class
-class KrylovAlgebra(_Algebra):
-    """Matrix-free KKT solves on the constraints' tangent space (module docstring); the
-    interface of `_linear.py`'s back ends.  A pytree: the pattern's index arrays (if the
-    problem is local) are its leaves."""
+class Krylov(LinearSolver):
+    """Matrix-free KKT solves (module docstring): GMRES with the block-tridiagonal preconditioner
+    on chains, MINRES on the constraints' tangent space otherwise, each to the relative
+    tolerance `rtol` in at most `maxiter` iterations (default 2N + 50).  A pytree: the
+    pattern's index arrays (if the problem is local) are its leaves."""
 
     def __init__(self, pattern: SparsePattern | None = None, rtol: float = RTOL, maxiter: int | None = None,
                  index: dict | None = None, chain: Chain | None = None):
@@ -219,16 +220,20 @@ class KrylovAlgebra(_Algebra):
             index = dict(index_arrays(pattern), **({} if chain is None else chain_arrays(chain)))
         self.index = index
 
-    @classmethod
-    def of(cls, pattern: SparsePattern | None, spec) -> KrylovAlgebra:
-        """The back end for a problem: with the block-tridiagonal preconditioner if it is a chain."""
-        if pattern is None:
-            return cls()
+    def bind(self, problem, spec) -> Krylov:
+        """Assembled products for a problem declared local, with the block-tridiagonal
+        preconditioner if it is a chain; autodiff products otherwise."""
+        if not spec.is_local:
+            return type(self)(None, self.rtol, self.maxiter)
+        pattern = cached_pattern(spec, problem.x0, problem.params)
         shape = spec.layout.shapes[0]
         width = shape[1] if len(shape) == 2 else 1
         # made once per pattern: jit's cache compares it by identity
         chain = derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width))
-        return cls(pattern, chain=chain)
+        return type(self)(pattern, self.rtol, self.maxiter, chain=chain)
+
+    def __repr__(self):
+        return f"Krylov(rtol={self.rtol:g}, maxiter={self.maxiter})"
 
     def tree_flatten(self):
         names = () if self.index is None else tuple(sorted(self.index))
@@ -313,7 +318,7 @@ class KrylovAlgebra(_Algebra):
     def _apply_chain(self, fac: Factored, b):
         """GMRES on `(K + μS) d = b` preconditioned by the block-tridiagonal solve (`_banded`)."""
         K = fac.K
-        shift = _regularisation(K.n, K.m, fac.mu)  # μS, as the direct back ends add it
+        shift = regularisation(K.n, K.m, fac.mu)  # μS, as the direct back ends add it
 
         def A(v):
             return K.kvp(v) + shift * v
@@ -339,4 +344,4 @@ class KrylovAlgebra(_Algebra):
         return d
 
 
-__all__ = ["KrylovAlgebra", "minres"]
+__all__ = ["Krylov", "minres"]

@@ -55,7 +55,7 @@ def _merit(R):
     return 0.5 * jnp.dot(R, R)
 
 
-def _newton_trial(kkt: KKT, algebra, K, w, R):
+def _newton_trial(kkt: KKT, linear, K, w, R):
     """Damped Newton step with Deuflhard's affine-covariant monotonicity test.
 
     With the Newton correction `Δ = −K(w)⁻¹R(w)` and, for a trial `w + αΔ`, the simplified
@@ -66,10 +66,10 @@ def _newton_trial(kkt: KKT, algebra, K, w, R):
     `|Δ̄| = O(|Δ|²)` and α = 1: quadratic convergence.  Returns (α Δ, R(w + αΔ), accepted,
     at_roundoff), the last flag saying that the Newton correction is at the round-off level of
     w, so that a rejected step means the residual cannot be reduced further in float64.
-    `K = algebra.matrix(kkt, w)`.
+    `K = linear.matrix(kkt, w)`.
     """
-    fac = algebra.factor_matrix(kkt, K, NEWTON_MU)
-    delta = algebra.apply(fac, -R)
+    fac = linear.factor_matrix(kkt, K, NEWTON_MU)
+    delta = linear.apply(fac, -R)
     size = jnp.linalg.norm(delta)
 
     def cond(carry):
@@ -80,7 +80,7 @@ def _newton_trial(kkt: KKT, algebra, K, w, R):
         # one trace of the trial (the loop starts at α = 2, so that its first trial is α = 1)
         alpha = 0.5 * carry[0]
         R_new = kkt.residual(w + alpha * delta)
-        simplified = jnp.linalg.norm(algebra.apply(fac, -R_new))
+        simplified = jnp.linalg.norm(linear.apply(fac, -R_new))
         ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & (simplified <= (1 - alpha / 4) * size)
         return alpha, R_new, ok
 
@@ -90,12 +90,12 @@ def _newton_trial(kkt: KKT, algebra, K, w, R):
     return alpha * delta, R_new, ok & jnp.isfinite(size), at_roundoff
 
 
-def _lm_trial(kkt: KKT, algebra, K, w, R, theta):
+def _lm_trial(kkt: KKT, linear, K, w, R, theta):
     """One Levenberg–Marquardt trial; returns the step, new residual, acceptance and new θ."""
     nu = theta * jnp.linalg.norm(R)
-    d = algebra.lm_solve_matrix(K, nu, R)
+    d = linear.lm_solve_matrix(K, nu, R)
     R_new = kkt.residual(w + d)
-    predicted = _merit(R) - _merit(R + algebra.matvec(K, d))
+    predicted = _merit(R) - _merit(R + linear.matvec(K, d))
     actual = _merit(R) - _merit(R_new)
     rho = jnp.where(predicted > 0, actual / predicted, -1.0)
     rho = jnp.where(jnp.isfinite(rho) & jnp.all(jnp.isfinite(d)), rho, -1.0)
@@ -103,7 +103,7 @@ def _lm_trial(kkt: KKT, algebra, K, w, R, theta):
     return d, R_new, rho > ARMIJO, theta
 
 
-def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
+def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
     n = kkt.spec.n
     R0 = kkt.residual(w0)
     res0 = scaled_residual(R0, weights, n)
@@ -117,8 +117,8 @@ def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> New
         return s.status == RUNNING
 
     def body(s: NewtonState) -> NewtonState:
-        K = algebra.matrix(kkt, s.w)  # the second derivatives, once per step
-        d, R_new, ok, at_roundoff = _newton_trial(kkt, algebra, K, s.w, s.R)
+        K = linear.matrix(kkt, s.w)  # the second derivatives, once per step
+        d, R_new, ok, at_roundoff = _newton_trial(kkt, linear, K, s.w, s.R)
         theta = jnp.where(ok, jnp.maximum(s.theta / 4, THETA_MIN), s.theta)
         stuck = (~ok) & at_roundoff
 
@@ -129,7 +129,7 @@ def newton(kkt: KKT, algebra, w0, weights, *, tol: float, max_steps: int) -> New
             return ~carry[4] & ~stuck
 
         def lm_body(carry):
-            return _lm_trial(kkt, algebra, K, s.w, s.R, carry[3]) + (jnp.asarray(True),)
+            return _lm_trial(kkt, linear, K, s.w, s.R, carry[3]) + (jnp.asarray(True),)
 
         d, R_new, ok, theta, _ = jax.lax.while_loop(lm_cond, lm_body, (d, R_new, ok, theta, ok))
         w = jnp.where(ok, s.w + d, s.w)

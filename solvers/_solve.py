@@ -15,8 +15,13 @@ from ddgjax.problem import Problem, flatten_multipliers
 from ._first_order import augmented_lagrangian
 from ._implicit import implicit_solution
 from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
-from ._krylov import KrylovAlgebra
-from ._linear import DenseAlgebra, SparseAlgebra
+from ._banded import chain_structure
+from ._cache import derived
+from ._dense import DenseLU
+from ._direct import SparseDirect
+from ._klu import KLU
+from ._krylov import Krylov
+from ._linear import LinearSolver
 from ._newton import CONVERGED, NONFINITE, STATUS_TEXT, newton
 from ._sparse import cached_pattern
 
@@ -54,11 +59,11 @@ DENSE_MAX = 2000  # unknowns + multipliers: dense LU beyond this costs seconds a
 def choose_method(spec: Spec, backend: str) -> str:
     """The linear algebra `method="auto"` uses, by size and backend.
 
-    - `"sparse"` (KLU) for a problem declared local on the CPU: there it beats dense LU at every
+    - `"sparse"` for a problem declared local on the CPU: there it beats dense LU at every
       size we measured (N = 10²: 1.0 vs 2.6 ms, `benchmarks/solver.py`);
     - `"dense"` when N = n + m ≤ `DENSE_MAX` otherwise (one LU on an accelerator is fast);
-    - `"krylov"` for larger problems that are not local-on-CPU (KLU runs on the CPU only, and
-      dense LU does not fit): no factorisation, inside `jit` on any backend.
+    - `"krylov"` for larger problems that are not local-on-CPU (the sparse factorisations run on
+      the CPU only, and dense LU does not fit): no factorisation, inside `jit` on any backend.
     """
     if spec.is_local and backend == "cpu":
         return "sparse"
@@ -67,23 +72,46 @@ def choose_method(spec: Spec, backend: str) -> str:
     return "krylov"
 
 
-def _choose_algebra(problem: Problem, spec: Spec, method: str):
-    if method == "sparse" and not spec.is_local:
+def is_chain(problem: Problem, spec: Spec) -> bool:
+    """Whether the local problem's KKT matrix is block tridiagonal up to a border (a curve)."""
+    pattern = cached_pattern(spec, problem.x0, problem.params)
+    shape = spec.layout.shapes[0]
+    width = shape[1] if len(shape) == 2 else 1
+    return derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width)) is not None
+
+
+def sparse_direct_for(problem: Problem, spec: Spec) -> LinearSolver:
+    """`method="sparse"`: KLU for chains (banded, no fill: KLU is fastest there), the
+    fill-reducing `SparseDirect` otherwise (meshes)."""
+    return KLU() if is_chain(problem, spec) else SparseDirect()
+
+
+def linear_solver_of(problem: Problem, spec: Spec, method: str, linear_solver: LinearSolver | None) -> LinearSolver:
+    """The bound linear solver of a solve: `linear_solver` if given, else the one `method` names."""
+    if linear_solver is None:
+        if method == "auto":
+            method = choose_method(spec, jax.default_backend())
+        if method == "sparse" and not spec.is_local:
+            raise InvalidInputError(
+                "method='sparse' needs an energy declared with dg.local_sum (and constraints with "
+                "dg.local_map / dg.local_sum / dg.concat) over a single array of unknowns"
+            )
+        linear_solver = {"dense": DenseLU, "krylov": Krylov}.get(method, lambda: sparse_direct_for(problem, spec))()
+    elif not isinstance(linear_solver, LinearSolver):
         raise InvalidInputError(
-            "method='sparse' needs an energy declared with dg.local_sum (and constraints with "
-            "dg.local_map / dg.local_sum / dg.concat) over a single array of unknowns"
+            f"linear_solver must be a solvers.LinearSolver (DenseLU(), KLU(), SparseDirect(), Krylov()), "
+            f"got {type(linear_solver).__name__}"
         )
-    if method == "auto":
-        method = choose_method(spec, jax.default_backend())
-    if method == "sparse":
-        return SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
-    if method == "krylov":
-        return KrylovAlgebra.of(cached_pattern(spec, problem.x0, problem.params) if spec.is_local else None, spec)
-    return DenseAlgebra()
+    elif linear_solver.needs_locality and not spec.is_local:
+        raise InvalidInputError(
+            f"{linear_solver!r} assembles a sparse KKT matrix: it needs an energy declared with dg.local_sum "
+            "(and constraints with dg.local_map / dg.local_sum / dg.concat) over a single array of unknowns"
+        )
+    return linear_solver.bind(problem, spec)
 
 
 @partial(jax.jit, static_argnames=("spec", "tol", "max_steps", "first_order", "newton_phase"))
-def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
+def _solve_jit(spec, linear, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
     z0_, params_ = jax.lax.stop_gradient((z0, params))
     kkt = KKT(spec, z0_, params_)
     u0 = z0_[spec.layout.free]
@@ -92,14 +120,14 @@ def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, firs
         grad_e = jax.grad(kkt.energy)(u0)
         w_probe = jnp.concatenate([u0, jnp.zeros((spec.m,), u0.dtype)])
         rhs = jnp.concatenate([grad_e, jnp.zeros((spec.m,), u0.dtype)])
-        lam0 = -algebra.solve(kkt, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
+        lam0 = -linear.solve(kkt, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
         lam0 = jnp.where(jnp.isfinite(lam0), lam0, 0.0)
     w = jnp.concatenate([u0, lam0])
     fo_steps = jnp.asarray(0)
     if first_order:
         w, fo_steps, _ = augmented_lagrangian(kkt, w, weights, tol=tol, outer_steps=first_order)
     if newton_phase:
-        state = newton(kkt, algebra, w, weights, tol=tol, max_steps=max_steps)
+        state = newton(kkt, linear, w, weights, tol=tol, max_steps=max_steps)
         w, residual, steps, history, status = state.w, state.residual, state.step, state.history, state.status
     else:
         residual = scaled_residual(kkt.residual(w), weights, spec.n)
@@ -107,7 +135,7 @@ def _solve_jit(spec, algebra, z0, params, lam0, weights, *, tol, max_steps, firs
         finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
         status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
 
-    w = implicit_solution(spec, jax.lax.stop_gradient(algebra), w, z0, params)
+    w = implicit_solution(spec, jax.lax.stop_gradient(linear), w, z0, params)
     kkt_diff = KKT(spec, z0, params)
     u, lam = kkt_diff.split(w)
     x = kkt_diff.x(u)
@@ -121,6 +149,7 @@ def solve(
     tol: float = 1e-10,
     max_steps: int = 100,
     method: str = "auto",
+    linear_solver: LinearSolver | None = None,
     throw: bool = True,
     multipliers0=None,
     warm_start: str | None = None,
@@ -135,13 +164,16 @@ def solve(
     **Arguments:**
     - `tol`: stop when the scaled max-norm KKT residual is `<= tol` (see `Problem.residual_scale`).
     - `max_steps`: Newton steps (outer augmented-Lagrangian steps for `method="lbfgs"`).
-    - `method`: `"dense"` (LU, n ≲ 2,000), `"sparse"` (KLU on the KKT matrix assembled from a
-      locality declaration, `dg.local_sum`; CPU), `"krylov"` (inside `jit` on any backend,
+    - `method`: `"dense"` (LU, n ≲ 2,000), `"sparse"` (a sparse direct solve of the KKT matrix
+      assembled from a locality declaration, `dg.local_sum`, on the CPU: KLU for curves,
+      `SparseDirect` for meshes), `"krylov"` (inside `jit` on any backend,
       `solvers/_krylov.py`: GMRES preconditioned by a block-tridiagonal solve for problems on
       curves, MINRES on the constraints' tangent space with a Jacobi metric otherwise),
       `"lbfgs"` (augmented Lagrangian with jaxopt L-BFGS inner solves: minimisation only,
       first-order), or `"auto"` (`choose_method`: sparse for a problem declared local on the
       CPU, else dense up to N = n + m = 2,000 unknowns and multipliers, else Krylov).
+    - `linear_solver`: a `solvers.LinearSolver` object (`DenseLU()`, `KLU()`, `SparseDirect()`,
+      `Krylov(rtol=…)`, or your own) for the Newton steps; overrides `method`'s choice.
     - `throw`: raise `ConvergenceError` when not converged (only outside `jit`/`vmap`; inside
       them check `Solution.converged`).
     - `multipliers0`: starting multipliers, flat or named like `Solution.multipliers` (default:
@@ -170,16 +202,16 @@ def solve(
     spec = spec_of(problem)
     if spec.n == 0:
         raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
-    algebra = _choose_algebra(problem, spec, "dense" if method == "lbfgs" else method)
+    linear = linear_solver_of(problem, spec, "dense" if method == "lbfgs" else method, linear_solver)
     z0 = spec.layout.ravel(problem.x0)
     lam0 = None if lam0 is None else lam0.astype(z0.dtype)
     first_order = FIRST_ORDER_OUTER if warm_start == "lbfgs" else (int(max_steps) if method == "lbfgs" else 0)
     try:
         sol = _solve_jit(
-            spec, algebra, z0, problem.params, lam0, residual_weights(problem, spec),
+            spec, linear, z0, problem.params, lam0, residual_weights(problem, spec),
             tol=float(tol), max_steps=int(max_steps), first_order=first_order, newton_phase=method != "lbfgs",
         )
-    except jax.errors.JaxRuntimeError as err:  # KLU reports an exactly singular matrix this way
+    except jax.errors.JaxRuntimeError as err:  # KLU and the host factorisations report a singular matrix so
         raise ConvergenceError(
             f"{_label(problem)}the sparse linear solve failed ({err}); try method='dense' to diagnose",
             residual=float("nan"), steps=0,

@@ -106,13 +106,13 @@ def test_auto_picks_method_by_size_and_backend(n, m, local, backend, expected):
 
 def _kkt_at_solution(problem):
     from solvers._kkt import KKT, spec_of
-    from solvers._solve import _choose_algebra
+    from solvers._solve import linear_solver_of
 
     spec = spec_of(problem)
     sol = solve(problem, method="sparse")
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
     w = jnp.concatenate([spec.layout.ravel(sol.x)[spec.layout.free], flatten_multipliers(problem, sol.multipliers)])
-    return kkt, w, _choose_algebra(problem, spec, "krylov")
+    return kkt, w, linear_solver_of(problem, spec, "krylov", None)
 
 
 def test_block_tridiagonal_solve_is_exact_on_a_chain_without_border():
@@ -120,7 +120,7 @@ def test_block_tridiagonal_solve_is_exact_on_a_chain_without_border():
     Thomas algorithm of `_banded` inverts the whole KKT matrix."""
     from energies import pendulum
     from solvers import _banded
-    from solvers._linear import DenseAlgebra
+    from solvers._dense import DenseLU
 
     problem = pendulum.action(12, a=[0.0, 0.0, -2.0], T_first=[1.0, 0.2, 0.0], T_last=[-0.2, 1.0, 0.4])
     kkt, w, algebra = _kkt_at_solution(problem)
@@ -132,20 +132,20 @@ def test_block_tridiagonal_solve_is_exact_on_a_chain_without_border():
         fac = algebra.factor_matrix(kkt, algebra.matrix(kkt, w), 0.0)
         return _banded.solve(algebra.chain, algebra.index, fac.chain, b)
 
-    exact = np.linalg.solve(np.asarray(DenseAlgebra().matrix(kkt, w)), np.asarray(b))
+    exact = np.linalg.solve(np.asarray(DenseLU().matrix(kkt, w)), np.asarray(b))
     assert float(np.max(np.abs(np.asarray(block_solve(w, b)) - exact))) <= 1e-10 * np.max(np.abs(exact))
 
 
 def test_chain_preconditioned_gmres_solves_the_bordered_elastica_kkt_system():
     """The chord's three multipliers border the block-tridiagonal matrix; GMRES preconditioned by
     the block solve accounts for them: the Krylov solve equals the dense one."""
-    from solvers._linear import DenseAlgebra
+    from solvers._dense import DenseLU
 
     kkt, w, algebra = _kkt_at_solution(_elastica(12))
     assert algebra.chain is not None
     b = jnp.asarray(np.random.default_rng(1).normal(size=w.size))
     d = jax.jit(lambda w, b: algebra.solve(kkt, w, 0.0, b))(w, b)
-    K = np.asarray(DenseAlgebra().matrix(kkt, w))
+    K = np.asarray(DenseLU().matrix(kkt, w))
     assert float(np.max(np.abs(K @ np.asarray(d) - np.asarray(b)))) <= 1e-9
 
 
@@ -157,9 +157,9 @@ def test_meshes_are_not_chains():
     V, F = __import__("ddgjax").mesh.disk(4, 12)
     problem = area.simplicial(np.asarray(V, float) + [0.0, 0.0, 0.1], F)
     from solvers._kkt import spec_of
-    from solvers._solve import _choose_algebra
+    from solvers._solve import linear_solver_of
 
-    assert _choose_algebra(problem, spec_of(problem), "krylov").chain is None
+    assert linear_solver_of(problem, spec_of(problem), "krylov", None).chain is None
 
 
 def test_elastica_declared_alike_reuse_the_compiled_krylov_solver():

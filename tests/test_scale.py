@@ -18,7 +18,8 @@ from ddgjax import quaternion as qt
 from energies import area, dirichlet, elastica, pendulum, rod
 from solvers import solve, solve_batch
 from solvers._kkt import KKT, spec_of
-from solvers._linear import DenseAlgebra, SparseAlgebra
+from solvers._dense import DenseLU
+from solvers._klu import KLU
 from solvers._sparse import cached_pattern
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -142,9 +143,9 @@ def test_catalogue_is_local_and_sparse_kkt_equals_dense(name):
     rng = np.random.default_rng(7)
     u = kkt.spec.layout.ravel(problem.x0)[spec.layout.free] + 0.01 * rng.normal(size=spec.n)
     w = jnp.concatenate([u, jnp.asarray(rng.normal(size=spec.m))])
-    sparse = SparseAlgebra(cached_pattern(spec, problem.x0, problem.params))
+    sparse = KLU(cached_pattern(spec, problem.x0, problem.params))
     K_sparse = _dense_from_coo(sparse.pattern, jax.jit(lambda w: sparse.matrix(kkt, w))(w))
-    K_dense = np.asarray(jax.jit(lambda w: DenseAlgebra().matrix(kkt, w))(w))
+    K_dense = np.asarray(jax.jit(lambda w: DenseLU().matrix(kkt, w))(w))
     assert np.max(np.abs(K_sparse - K_dense)) <= 1e-12 * max(1.0, np.max(np.abs(K_dense)))
 
 

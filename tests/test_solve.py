@@ -168,11 +168,11 @@ def test_sparse_kkt_matrix_equals_dense_hessian():
 
 def test_auto_uses_sparse_path_for_local_problems():
     from solvers._kkt import spec_of
-    from solvers._linear import SparseAlgebra
-    from solvers._solve import _choose_algebra
+    from solvers._klu import KLU
+    from solvers._solve import linear_solver_of
 
     problem = unit_chain(600, noise=0.5 / 600)
-    assert isinstance(_choose_algebra(problem, spec_of(problem), "auto"), SparseAlgebra)
+    assert isinstance(linear_solver_of(problem, spec_of(problem), "auto", None), KLU)
     sol = solve(problem)
     assert float(sol.residual) <= 1e-10
 
@@ -206,12 +206,12 @@ def test_residual_scale_is_applied():
 def test_klu_solve_with_sorted_indices_matches_dense():
     """Our direct use of KLU (pre-sorted indices, reused symbolic analysis) solves K x = b."""
     from solvers._kkt import KKT, spec_of
-    from solvers._linear import SparseAlgebra
+    from solvers._klu import KLU
     from solvers._sparse import build_pattern
 
     problem = unit_chain(9, chord=(7.5, 3.5, 0.2))
     spec = spec_of(problem)
-    algebra = SparseAlgebra(build_pattern(spec, problem.x0, problem.params))
+    algebra = KLU(build_pattern(spec, problem.x0, problem.params))
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
     rng = np.random.default_rng(3)
     w, b = (jnp.asarray(rng.normal(size=spec.n + spec.m)) for _ in range(2))

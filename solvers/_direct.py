@@ -1,0 +1,248 @@
+"""`SparseDirect`: a fill-reducing sparse direct solver on the host, for the KKT systems of meshes.
+
+On a 2-D mesh the factor of the KKT matrix fills in like that of a 2-D Laplacian: with a
+nested-dissection or minimum-degree ordering about O(n log n) entries and O(n^1.5) flops,
+which supernodal codes do at dense-BLAS speed.  The factorisation runs in a host callback
+(`jax.pure_callback`), so `solve` stays one compiled program: the KKT values are assembled on
+the device exactly as for `KLU` (`AssembledSparse`), then
+
+- `factor_matrix` hands the values of `K + μS` to the host, which factorises them (reusing the
+  ordering and symbolic analysis made once per pattern) and returns a *token* naming the
+  factorisation it keeps;
+- `apply(token, b)` solves with that factorisation (Newton's damping test reuses it).
+
+The host keeps, per thread, the factorisations of the latest `factor_matrix` call only: a
+Newton step's factorisation is dead once the next one is made, because the next step depends
+on the results of the current step's solves.  `jax.vmap` calls each callback once with the whole
+batch (`vmap_method="broadcast_all"`), which factorises every member and keeps them all.
+`jax.grad` works as on every back end (the adjoint is one more factorisation and solve, `K`
+being symmetric).  Tracing, transformations and device placement are those of a host callback:
+CPU and GPU runs both work, a GPU run copies the values to the host and back each step.
+
+The KKT pattern is symmetric and kept sorted by (row, col), so its COO arrays are already the
+CSR arrays of K and, K being symmetric, its CSC arrays too: no permutation per step.
+
+Factorisers (`factoriser=`), chosen by measurement (`benchmarks/linear_solvers.py`):
+- `"cholmod"`: CHOLMOD (scikit-sparse), supernodal Cholesky `LLᵀ` with its symbolic analysis
+  (AMD/METIS ordering) made once per pattern; for an unconstrained problem near a minimum,
+  where `H + μI` is positive definite.  When the numeric Cholesky finds a nonpositive pivot
+  (a saddle, or constraints: the KKT matrix is indefinite) the step falls back to:
+- `"superlu"`: SuperLU (scipy `splu`) with the COLAMD ordering on `Kᵀ + K` and symmetric
+  mode, partial pivoting restricted to the diagonal where stable: any nonsingular K.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ddgjax.errors import InvalidInputError
+
+from ._cache import derived
+from ._klu import AssembledSparse
+from ._sparse import SparsePattern
+
+FACTORISERS = ("auto", "cholmod", "superlu")
+ORDERING = "nesdis"  # CHOLMOD's nested dissection: the least fill and time on 2-D meshes (measured)
+
+
+def _csc_structure(pattern: SparsePattern) -> tuple[np.ndarray, np.ndarray]:
+    """`(indptr, indices)` of K in CSC (= CSR: K symmetric, the COO sorted by row then column)."""
+    size = pattern.n + pattern.m
+    indptr = np.zeros(size + 1, np.int64)
+    np.cumsum(np.bincount(pattern.rows, minlength=size), out=indptr[1:])
+    return indptr, pattern.cols.astype(np.int64)
+
+
+def _cholmod_available() -> bool:
+    try:
+        import sksparse.cholmod  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class Factorisation:
+    """A numeric factorisation: `solve(b)` applies its inverse; `negative` is the number of
+    negative eigenvalues of the matrix (its inertia, from the pivots of `LDLᵀ` by Sylvester's
+    law), or −1 where the factoriser does not know it."""
+
+    solve: object
+    negative: int = -1
+
+
+PIVOT_FLOOR = 1e-14  # an LDLᵀ pivot below this, relative to the largest, falls back to LU with pivoting
+
+
+@dataclass(eq=False)
+class HostFactors:
+    """The host side of one pattern: its CSC structure, its symbolic analysis, and the live
+    numeric factorisations by token (the latest `factor` call's, per thread)."""
+
+    pattern: SparsePattern
+    factoriser: str
+    indptr: np.ndarray = field(init=False)
+    indices: np.ndarray = field(init=False)
+    _symbolic: object = field(init=False, default=None)
+    _live: dict = field(init=False, default_factory=dict)
+    _next: int = field(init=False, default=0)
+    _lock: threading.Lock = field(init=False, default_factory=threading.Lock)
+    _mine: threading.local = field(init=False, default_factory=threading.local)
+
+    def __post_init__(self):
+        self.indptr, self.indices = _csc_structure(self.pattern)
+
+    @property
+    def size(self) -> int:
+        return self.pattern.n + self.pattern.m
+
+    def matrix(self, values: np.ndarray):
+        import scipy.sparse as sp
+
+        return sp.csc_matrix((values, self.indices, self.indptr), shape=(self.size, self.size))
+
+    def _ldl(self, A) -> Factorisation | None:
+        """CHOLMOD's simplicial `LDLᵀ` (no pivoting: the fill-reducing ordering is kept), with the
+        analysis made once; None when a pivot is (nearly) zero or not finite."""
+        from sksparse.cholmod import CholmodError, analyze
+
+        if self._symbolic is None:
+            self._symbolic = analyze(A, mode="simplicial", ordering_method=ORDERING)
+        try:
+            fac = self._symbolic.cholesky(A)
+        except CholmodError:
+            return None
+        D = fac.D()
+        big = np.max(np.abs(D)) if D.size else 0.0
+        if not (np.all(np.isfinite(D)) and np.min(np.abs(D)) > PIVOT_FLOOR * big):
+            return None
+        return Factorisation(fac.solve_A, int(np.count_nonzero(D < 0)))
+
+    @staticmethod
+    def _lu(A) -> Factorisation:
+        """SuperLU with partial pivoting (any nonsingular matrix); inertia unknown."""
+        import scipy.sparse.linalg as spla
+
+        return Factorisation(spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
+                                       options={"SymmetricMode": True}).solve)
+
+    def factorise(self, values: np.ndarray) -> Factorisation:
+        """A factorisation of the matrix with these CSC values."""
+        A = self.matrix(values)
+        if self.factoriser == "cholmod":
+            fac = self._ldl(A)
+            if fac is not None:
+                return fac
+        return self._lu(A)
+
+    def factor(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Factorise each member of a batch of values (..., nnz); returns their tokens (...) and
+        the numbers of negative eigenvalues (..., −1 if unknown)."""
+        values = np.asarray(values)
+        batch = values.shape[:-1]
+        flat = values.reshape(-1, values.shape[-1])
+        made = [self.factorise(np.ascontiguousarray(v)) for v in flat]
+        with self._lock:
+            for token in getattr(self._mine, "tokens", ()):
+                self._live.pop(token, None)
+            tokens = np.arange(self._next, self._next + len(made), dtype=np.int64)
+            self._next += len(made)
+            self._live.update(zip(tokens.tolist(), made))
+        self._mine.tokens = tokens.tolist()
+        negative = np.array([fac.negative for fac in made], np.int64)
+        return tokens.reshape(batch), negative.reshape(batch)
+
+    def apply(self, tokens: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """`x = fac⁻¹ b` for each token (...) and right-hand side (..., size[, k])."""
+        tokens, b = np.asarray(tokens), np.asarray(b)
+        out = np.empty(b.shape, np.result_type(b.dtype, np.float64))
+        flat_t = tokens.reshape(-1)
+        flat_b = b.reshape((flat_t.size,) + b.shape[tokens.ndim:])
+        flat_out = out.reshape(flat_b.shape)
+        for i, token in enumerate(flat_t.tolist()):
+            with self._lock:
+                fac = self._live[token]
+            flat_out[i] = fac.solve(np.ascontiguousarray(flat_b[i]))
+        return out
+
+    def solve_complex(self, values: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Factorise-and-solve for complex values (..., nnz) and right-hand sides (..., size),
+        kept nowhere: the Levenberg–Marquardt fallback."""
+        values, b = np.asarray(values), np.asarray(b)
+        flat_v = values.reshape(-1, values.shape[-1])
+        flat_b = b.reshape(flat_v.shape[0], -1)
+        out = np.stack([self._lu(self.matrix(v)).solve(np.ascontiguousarray(r)) for v, r in zip(flat_v, flat_b)])
+        return out.reshape(b.shape)
+
+
+def host_factors(pattern: SparsePattern, factoriser: str) -> HostFactors:
+    """The host side of a pattern, made once per (pattern, factoriser) and kept while it lives."""
+    return derived(pattern, f"host:{factoriser}", lambda: HostFactors(pattern, factoriser))
+
+
+@jax.tree_util.register_pytree_node_class
+class SparseDirect(AssembledSparse):
+    """Sparse KKT matrix assembled from local blocks, factorised on the host by a fill-reducing
+    sparse direct solver (module docstring).  `factoriser="auto"` takes CHOLMOD where
+    scikit-sparse is installed, with SuperLU for indefinite matrices, else SuperLU alone."""
+
+    def __init__(self, pattern: SparsePattern | None = None, index: dict | None = None, *, factoriser: str = "auto"):
+        if factoriser not in FACTORISERS:
+            raise InvalidInputError(f"factoriser must be one of {FACTORISERS}, got {factoriser!r}")
+        if factoriser == "auto":
+            factoriser = "cholmod" if _cholmod_available() else "superlu"
+        if factoriser == "cholmod" and not _cholmod_available():
+            raise InvalidInputError("factoriser='cholmod' needs scikit-sparse (pip install scikit-sparse)")
+        self.factoriser = factoriser
+        super().__init__(pattern, index)
+
+    def bind(self, problem, spec):
+        from ._sparse import cached_pattern
+
+        return type(self)(cached_pattern(spec, problem.x0, problem.params), factoriser=self.factoriser)
+
+    def tree_flatten(self):
+        children, aux = super().tree_flatten()
+        return children, (aux, self.factoriser)
+
+    @classmethod
+    def tree_unflatten(cls, aux, children):
+        (key, names), factoriser = aux
+        if key is None:
+            return cls(factoriser=factoriser)
+        return cls(key.pattern, dict(zip(names, children)), factoriser=factoriser)
+
+    def __repr__(self):
+        return f"SparseDirect(factoriser={self.factoriser!r})"
+
+    @property
+    def host(self) -> HostFactors:
+        return host_factors(self.pattern, self.factoriser)
+
+    def factor_matrix(self, kkt, K, mu_rel):
+        """The token of the host's factorisation of `K + μS` (`inertia` also gives its count of
+        negative eigenvalues)."""
+        return self.factor_with_inertia(K, mu_rel)[0]
+
+    def factor_with_inertia(self, K, mu_rel):
+        """`(token, negative)`: the host's factorisation of `K + μS` and its number of negative
+        eigenvalues (−1 when the `LDLᵀ` fell back to LU)."""
+        values = self.regularised(K, mu_rel)
+        out = jax.ShapeDtypeStruct(values.shape[:-1], jnp.int64)
+        return jax.pure_callback(self.host.factor, (out, out), values, vmap_method="broadcast_all")
+
+    def apply(self, fac, b):
+        out = jax.ShapeDtypeStruct(b.shape, b.dtype)
+        return jax.pure_callback(self.host.apply, out, fac, b, vmap_method="broadcast_all")
+
+    def lm_solve_matrix(self, K, nu, R):
+        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric), one complex SuperLU solve."""
+        shifted = K.astype(jnp.complex128).at[self.index["diagonal"]].add(1j * jnp.sqrt(nu))
+        rhs = R.astype(jnp.complex128)
+        out = jax.ShapeDtypeStruct(rhs.shape, rhs.dtype)
+        return -jnp.real(jax.pure_callback(self.host.solve_complex, out, shifted, rhs, vmap_method="broadcast_all"))

@@ -1,0 +1,127 @@
+"""`KLU`: the KKT matrix assembled from local blocks (`_sparse.py`), factorised by KLU (klujax).
+
+Inside `jit`, `vmap`-able (a loop of factorisations), CPU only.  KLU orders for circuit
+matrices (block triangular form, then AMD on each block) and factorises left-looking without
+supernodes: the fastest choice for chains (curves, rods), where the KKT matrix is banded and
+fill is nil, but not for the 2-D fill of a mesh (`SparseLDL` there).  A constraint summed over
+all cells (a chord) is eliminated by its Schur complement (`_sparse.Bordered`).
+Its Levenberg–Marquardt step is one complex solve with `K + i√ν I`, on K's own pattern and
+KLU analysis.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from ._kkt import KKT
+from ._linear import MU_FLOOR, LinearSolver, regularisation
+from ._sparse import SPLIT_ARRAYS, PatternKey, SparsePattern, cached_pattern, index_arrays, kkt_values
+
+
+def _klu_solve(rows, cols, values, b, symbolic):
+    """Solve with KLU, reusing a symbolic analysis, for COO indices already sorted by (row, col).
+
+    `klujax.solve_with_symbol` lexsorts the indices on every call; our patterns are sorted
+    when built (`np.unique`), so we bind its primitive directly (`tests/test_solve.py` checks
+    this against `klujax.solve`).
+    """
+    import klujax
+
+    handle = jnp.asarray(symbolic.raw, dtype=jnp.uint64)
+    rhs = b.reshape(1, b.shape[0], -1)  # (n_lhs = 1, n_col, n_rhs)
+    solve = klujax.solve_with_symbol_c128 if jnp.iscomplexobj(values) else klujax.solve_with_symbol_f64
+    x = solve.bind(
+        jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], rhs, handle
+    )
+    return x.reshape(b.shape)
+
+
+def _bordered_solve(split, index: dict, values, b):
+    """Solve `[[A, B], [Bᵗ, C]] x = b` through the Schur complement of the border (`Bordered`);
+    `index` holds its arrays (`split_*`), `split` the sizes and KLU's analysis of A."""
+    ix = {name: index[f"split_{name}"] for name in SPLIT_ARRAYS}
+    n_in, p = len(split.interior), len(split.border)
+    B = jnp.zeros((n_in, p), values.dtype).at[ix["b_rows"], ix["b_cols"]].add(values[ix["take_b"]])
+    Bt = jnp.zeros((p, n_in), values.dtype).at[ix["bt_rows"], ix["bt_cols"]].add(values[ix["take_bt"]])
+    C = jnp.zeros((p, p), values.dtype).at[ix["c_rows"], ix["c_cols"]].add(values[ix["take_c"]])
+    rhs = jnp.concatenate([b[ix["interior"]][:, None], B], axis=1)
+    Y = _klu_solve(ix["a_rows"], ix["a_cols"], values[ix["take_a"]], rhs, split.symbolic())
+    schur = C - Bt @ Y[:, 1:]
+    x_border = jnp.linalg.solve(schur, b[ix["border"]] - Bt @ Y[:, 0])
+    x_interior = Y[:, 0] - Y[:, 1:] @ x_border
+    return jnp.zeros(b.shape, values.dtype).at[ix["interior"]].set(x_interior).at[ix["border"]].set(x_border)
+
+
+class AssembledSparse(LinearSolver):
+    """What the sparse direct back ends share: K as the coalesced COO values of the pattern
+    (`kkt_values`), its regularisation on the diagonal entries, and `K v` by a segment sum.
+    Subclasses are pytrees whose leaves are the pattern's index arrays (`index_arrays`) and whose
+    static part compares by the pattern's structure (`PatternKey`)."""
+
+    needs_locality = True
+
+    def __init__(self, pattern: SparsePattern | None = None, index: dict | None = None):
+        self.pattern = pattern
+        if index is None and pattern is not None:
+            self.prepare(pattern)
+            index = index_arrays(pattern)
+        self.index = index
+
+    def prepare(self, pattern: SparsePattern) -> None:
+        """The back end's analysis of the pattern, made once, outside any trace."""
+
+    def bind(self, problem, spec):
+        return type(self)(cached_pattern(spec, problem.x0, problem.params))
+
+    def tree_flatten(self):
+        names = () if self.index is None else tuple(sorted(self.index))
+        key = None if self.pattern is None else PatternKey(self.pattern)
+        return tuple(self.index[k] for k in names), (key, names)
+
+    @classmethod
+    def tree_unflatten(cls, aux, children):
+        key, names = aux
+        if key is None:
+            return cls()
+        return cls(key.pattern, dict(zip(names, children)))
+
+    def __repr__(self):
+        return f"{type(self).__name__}()" if self.pattern is None else f"{type(self).__name__}(N={self.pattern.n + self.pattern.m})"
+
+    def matrix(self, kkt: KKT, w, identity_hessian=False):
+        """Coalesced COO values of K (K's Hessian block replaced by I if asked)."""
+        return kkt_values(self.pattern, self.index, kkt, w, identity_hessian)
+
+    def factor_matrix(self, kkt: KKT, K, mu_rel):
+        return self.regularised(K, mu_rel)
+
+    def regularised(self, K, mu_rel):
+        """The values of `K + μS`, μ = mu_rel · max(|K|, 1)."""
+        n, m = self.pattern.n, self.pattern.m
+        scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
+        return K.at[self.index["diagonal"]].add(regularisation(n, m, jnp.maximum(mu_rel, MU_FLOOR) * scale))
+
+    def matvec(self, K, v):
+        return jax.ops.segment_sum(K * v[self.index["cols"]], self.index["rows"], num_segments=v.shape[0])
+
+
+@jax.tree_util.register_pytree_node_class
+class KLU(AssembledSparse):
+    """Sparse KKT matrix assembled from local blocks; KLU solve (klujax), inside `jit`."""
+
+    def prepare(self, pattern: SparsePattern) -> None:
+        if pattern.split() is None:  # KLU's analysis, made now, outside any trace
+            pattern.symbolic()
+
+    def apply(self, fac, b):
+        split = self.pattern.split()
+        if split is not None:
+            return _bordered_solve(split, self.index, fac, b)
+        return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.pattern.symbolic())
+
+    def lm_solve_matrix(self, K, nu, R):
+        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric: `(K + isI)⁻¹ = (K − isI)(K² + s²I)⁻¹`),
+        one complex KLU solve on K's own pattern and analysis, with smallest singular value ≥ √ν."""
+        shifted = K.astype(jnp.complex128).at[self.index["diagonal"]].add(1j * jnp.sqrt(nu))
+        return -jnp.real(self.apply(shifted, R.astype(jnp.complex128)))

@@ -1,0 +1,139 @@
+"""The linear solvers of `solve` as objects: every back end gives the same critical point,
+multipliers, derivatives and batches; `SparseDirect`'s `LDLᵀ` reports the inertia."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import ddgjax as dg
+from ddgjax.errors import InvalidInputError
+from energies import area, elastica
+from solvers import KLU, DenseLU, Krylov, LinearSolver, SparseDirect, solve, solve_batch
+from ddgjax.problem import flatten_multipliers
+from solvers._kkt import KKT, spec_of
+
+CLAMPED = dict(chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+BACK_ENDS = [DenseLU(), KLU(), SparseDirect(), SparseDirect(factoriser="superlu"), Krylov()]
+
+
+def _saddle(k: int = 8):
+    x = np.linspace(-1.0, 1.0, k)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    V = np.stack([X, Y, 0.25 * (X**2 - Y**2)], -1).reshape(-1, 3)
+    idx = np.arange(k * k).reshape(k, k)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    border = np.zeros((k, k), bool)
+    border[[0, -1], :] = border[:, [0, -1]] = True
+    V[~border.ravel(), 2] += 0.02 * np.random.default_rng(0).normal(size=int((~border).sum()))
+    V = area.minimal_surface(V, F, idx[border], method="cotan", max_iter=5, throw=False)[0]  # near the minimum
+    return V, F, idx[border]
+
+
+@pytest.fixture(scope="module")
+def reference():
+    problem = elastica.clamped(16, **CLAMPED)
+    return problem, solve(problem, linear_solver=DenseLU())
+
+
+@pytest.mark.parametrize("linear", BACK_ENDS, ids=repr)
+def test_every_back_end_finds_the_same_elastica(reference, linear):
+    problem, ref = reference
+    sol = solve(problem, linear_solver=linear)
+    assert float(sol.residual) <= 1e-10
+    assert np.max(np.abs(np.asarray(sol.x) - np.asarray(ref.x))) <= 1e-10
+    assert np.max(np.abs(np.asarray(sol.multipliers["chord"]) - np.asarray(ref.multipliers["chord"]))) <= 1e-8
+
+
+@pytest.mark.parametrize("linear", [SparseDirect(), SparseDirect(factoriser="superlu"), KLU()], ids=repr)
+def test_sparse_back_ends_agree_on_a_minimal_surface(linear):
+    V, F, boundary = _saddle()
+    problem = area.simplicial(V, F, boundary)
+    ref = solve(problem, linear_solver=DenseLU(), tol=1e-11)
+    sol = solve(problem, linear_solver=linear, tol=1e-11)
+    assert float(sol.residual) <= 1e-11
+    assert np.max(np.abs(np.asarray(sol.x) - np.asarray(ref.x))) <= 1e-10
+
+
+def test_method_sparse_takes_klu_on_chains_and_sparse_direct_on_meshes():
+    from solvers._solve import linear_solver_of
+
+    chain = elastica.clamped(16, **CLAMPED)
+    V, F, boundary = _saddle()
+    mesh = area.simplicial(V, F, boundary)
+    assert isinstance(linear_solver_of(chain, spec_of(chain), "sparse", None), KLU)
+    assert isinstance(linear_solver_of(mesh, spec_of(mesh), "sparse", None), SparseDirect)
+
+
+def test_gradient_and_batch_through_sparse_direct(reference):
+    """The adjoint solve (`apply_transpose`) and `vmap` (one host call per batch) of `SparseDirect`
+    give the dense path's derivative and the loop of single solves."""
+    problem, _ = reference
+
+    def energy(chord, linear):
+        return solve(problem.with_params({**problem.params, "chord": chord}), linear_solver=linear).energy
+
+    chord = jnp.asarray(problem.params["chord"])
+    g_dense = jax.grad(energy)(chord, DenseLU())
+    g_direct = jax.grad(energy)(chord, SparseDirect())
+    assert np.max(np.abs(g_direct - g_dense)) <= 1e-8 * np.max(np.abs(g_dense))
+    chords = chord + jnp.linspace(0.0, 0.05, 3)[:, None] * jnp.array([1.0, 0.0, 0.0])
+    batch = solve_batch(problem, {"chord": chords}, linear_solver=SparseDirect())
+    for k in range(3):
+        one = solve(problem.with_params({**problem.params, "chord": chords[k]}), linear_solver=KLU())
+        assert np.max(np.abs(np.asarray(batch.x[k]) - np.asarray(one.x))) <= 1e-12
+
+
+def test_ldl_inertia_counts_negative_eigenvalues():
+    """Sylvester's law: the negative pivots of `LDLᵀ` count the negative eigenvalues, here of the
+    area Hessian shifted between its 3rd and 4th eigenvalue (three negative ones)."""
+    V, F, boundary = _saddle()
+    problem = area.simplicial(V, F, boundary)
+    spec = spec_of(problem)
+    linear = SparseDirect().bind(problem, spec)
+    kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
+    K = linear.matrix(kkt, spec.layout.ravel(problem.x0)[spec.layout.free])
+    dense = np.zeros((spec.n, spec.n))
+    dense[linear.pattern.rows, linear.pattern.cols] = np.asarray(K)
+    eigenvalues = np.linalg.eigvalsh(dense)
+    shift = 0.5 * (eigenvalues[2] + eigenvalues[3])
+    shifted = K.at[linear.index["diagonal"]].add(-shift)
+    _, negative = linear.factor_with_inertia(shifted, 0.0)
+    assert int(negative) == 3
+    # negative control: the sign flipped, the complementary count
+    _, flipped = linear.factor_with_inertia(-shifted, 0.0)
+    assert int(flipped) == spec.n - 3
+
+
+def test_linear_solver_errors():
+    chain = elastica.clamped(8, **CLAMPED)
+    with pytest.raises(InvalidInputError, match="LinearSolver"):
+        solve(chain, linear_solver="klu")
+    with pytest.raises(InvalidInputError, match="factoriser"):
+        SparseDirect(factoriser="mumps")
+    not_local = dg.Problem(lambda x, p: jnp.sum((x - 1.0) ** 2), np.zeros(3))
+    with pytest.raises(InvalidInputError, match="dg.local_sum"):
+        solve(not_local, linear_solver=KLU())
+    assert isinstance(SparseDirect(), LinearSolver)
+
+
+def _tilted_saddle(x, _):
+    return x[0] ** 2 - x[1] ** 2 + x[1] ** 4
+
+
+def test_minimize_leaves_the_saddle_that_solve_finds():
+    """E = x² − y² + y⁴: Newton for critical points from near the origin stays at the saddle (0, 0);
+    `minimize` (inertia correction) reaches a minimum (0, ±1/√2), Hessian diag(2, 4)."""
+    from solvers import minimize
+
+    problem = dg.Problem(_tilted_saddle, np.array([0.1, 1e-3]))
+    saddle = solve(problem)
+    assert np.max(np.abs(np.asarray(saddle.x))) < 1e-10  # negative control: solve finds the saddle
+    minimum = minimize(problem)
+    assert abs(abs(float(minimum.x[1])) - 2**-0.5) < 1e-12 and abs(float(minimum.x[0])) < 1e-12
+    assert abs(float(minimum.energy) + 0.25) < 1e-14
+    H = np.asarray(jax.hessian(lambda x: _tilted_saddle(x, None))(minimum.x))
+    assert np.min(np.linalg.eigvalsh(H)) > 1.0
+    with pytest.raises(InvalidInputError, match="constraints"):
+        minimize(elastica.clamped(8, **CLAMPED))
