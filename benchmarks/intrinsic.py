@@ -5,41 +5,47 @@ side by side with libigl's `intrinsic_delaunay_cotmatrix` and robust-laplacian's
 
 Meshes of about 10⁴, 10⁵, 10⁶ faces: a round icosphere (Delaunay already, no flips), a strongly
 stretched ellipsoid (the icosphere scaled 20 : 1 : 1) and a sheared, squashed torus of thin
-triangles; the last two need about 1.5 flips per face.  ddgjax's flips are numpy (no JIT); its
-cotan weights are one jit-compiled autodiff kernel, compiled for a few shape buckets (the first
-call is a warm-up and not counted).  Calls are interleaved and both wall and CPU
-time (`time.process_time`, all three run on one core) are reported: on a shared machine the CPU
-time is the fairer measure.  The flip phase is also timed alone (`flip_to_delaunay` on a prebuilt
-triangulation, no history) and divided by the flip count.
+triangles; the last two need about 1.5 flips per face.  ddgjax's flip loop is compiled by numba
+(cached on disk: a fresh machine compiles it once, about 2.5 s CPU); its cotan weights are one
+jit-compiled autodiff kernel, compiled for a few shape buckets (the first call is a warm-up and
+not counted).  Calls are interleaved and both wall and CPU time (`time.process_time`, all three
+run on one core) are reported: on a shared machine the CPU time is the fairer measure.  The flip
+phase is also timed alone (`flip_to_delaunay` on a prebuilt triangulation, no history: the
+derived cotangents of the start and of the result, and the flip loop) and divided by the flip
+count.
 
     python benchmarks/intrinsic.py [--quick | --large] [--repeats 3] [--repeats-large 2] [--rl-repeats-large 0]
 
-Measured 2026-11-22 on the shared 2-core development machine (other jobs running: CPU times are
-the comparison), libigl and robust-laplacian from pip, medians of 3 (2 above 5·10⁵ faces;
-robust-laplacian once there):
+Measured 2026-12-01 on the shared 2-core development machine (other jobs running, load about
+3–4: noisy; CPU times are the comparison), libigl and robust-laplacian from pip, medians of 3 (2
+above 5·10⁵ faces; robust-laplacian once there):
 
 | mesh | faces | flips | rounds | flip phase CPU (ns/flip) | ddgjax CPU (s) | libigl CPU (s) | robust-laplacian CPU (s) | igl / ddgjax | rl / ddgjax | ddgjax wall (s) | libigl wall (s) | robust-laplacian wall (s) | max rel diff vs igl |
 |---|---|---|---|---|---|---|---|---|---|---|---|---|---|
-| sphere | 20480 | 0 | 0 | – | 0.006 | 0.014 | 0.040 | 2.20 | 6.34 | 0.006 | 0.014 | 0.040 | 4.9e-16 |
-| sphere | 81920 | 0 | 0 | – | 0.024 | 0.056 | 0.204 | 2.28 | 8.38 | 0.024 | 0.056 | 0.207 | 4.9e-16 |
-| sphere | 1310720 | 0 | 0 | – | 0.497 | 1.373 | 8.440 | 2.76 | 16.98 | 0.499 | 1.345 | 8.567 | 6.1e-16 |
-| ellipsoid 20:1:1 | 20480 | 32043 | 16 | 277 | 0.015 | 0.019 | 0.068 | 1.24 | 4.38 | 0.015 | 0.019 | 0.068 | 4.0e-13 |
-| ellipsoid 20:1:1 | 81920 | 129391 | 17 | 354 | 0.058 | 0.106 | 0.564 | 1.83 | 9.74 | 0.058 | 0.105 | 0.564 | 2.5e-12 |
-| ellipsoid 20:1:1 | 1310720 | 2037985 | 17 | 343 | 1.067 | 2.385 | 17.137 | 2.24 | 16.06 | 1.067 | 2.355 | 17.146 | 2.5e-12 |
-| sheared torus | 10000 | 15380 | 15 | 319 | 0.007 | 0.007 | 0.016 | 0.94 | 2.24 | 0.007 | 0.007 | 0.016 | 1.5e-13 |
-| sheared torus | 102400 | 158208 | 10 | 204 | 0.051 | 0.069 | 0.265 | 1.34 | 5.15 | 0.051 | 0.069 | 0.265 | 3.6e-15 |
-| sheared torus | 1310720 | 2552580 | 12 | 295 | 0.871 | 1.275 | 5.907 | 1.46 | 6.79 | 0.873 | 1.272 | 5.909 | 3.4e-15 |
+| sphere | 20480 | 0 | 0 | – | 0.008 | 0.013 | 0.041 | 1.57 | 4.96 | 0.012 | 0.016 | 0.084 | 4.9e-16 |
+| sphere | 81920 | 0 | 0 | – | 0.028 | 0.060 | 0.237 | 2.12 | 8.33 | 0.043 | 0.092 | 0.346 | 4.9e-16 |
+| sphere | 1310720 | 0 | 0 | – | 0.876 | 1.638 | 8.633 | 1.87 | 9.85 | 1.307 | 2.432 | 12.368 | 6.1e-16 |
+| ellipsoid 20:1:1 | 20480 | 31052 | 18 | 200 | 0.014 | 0.019 | 0.098 | 1.41 | 7.23 | 0.017 | 0.026 | 0.139 | 3.9e-13 |
+| ellipsoid 20:1:1 | 81920 | 126239 | 19 | 197 | 0.047 | 0.107 | 0.622 | 2.26 | 13.09 | 0.068 | 0.167 | 0.921 | 2.5e-12 |
+| ellipsoid 20:1:1 | 1310720 | 2025068 | 17 | 254 | 1.163 | 2.853 | 21.014 | 2.45 | 18.07 | 1.817 | 4.214 | 31.325 | 2.5e-12 |
+| sheared torus | 10000 | 15351 | 13 | 217 | 0.006 | 0.009 | 0.024 | 1.59 | 4.31 | 0.010 | 0.021 | 0.034 | 1.5e-13 |
+| sheared torus | 102400 | 158208 | 10 | 173 | 0.046 | 0.072 | 0.336 | 1.56 | 7.24 | 0.074 | 0.116 | 0.521 | 3.6e-15 |
+| sheared torus | 1310720 | 2552580 | 12 | 182 | 0.884 | 1.393 | 6.782 | 1.58 | 7.67 | 1.337 | 2.070 | 10.018 | 3.2e-15 |
 
-Reading: at 1.3·10⁶ faces ddgjax is 1.5× faster than libigl on the sheared torus, 2.2× on the
-stretched ellipsoid and 2.8× on the sphere, and 7–17× faster than robust-laplacian (2.2× on
-the smallest torus, where libigl and ddgjax tie).  The flip loop costs 0.2–0.35 µs per flip
-(vectorised numpy, no JIT; scattered writes and boolean compressions dominate, so a flip writes
-as few entries as it can), against about 0.07–0.1 µs for a compiled sequential loop: ddgjax
-makes up for it in the gluing (one sort of the halfedges), the renumbering (radix sorts) and
-the assembly.  Time grows about linearly: from 10⁵ to 1.3·10⁶ faces (×13–16) it grows ×17–21
-(cache misses add a little); meshes whose vertex labels are not spatially coherent are
-renumbered along a Morton curve first (`ddgjax.intrinsic.ordering`), which halves the flip time
-on the icospheres.  `--large` runs only the 1.3·10⁶-face meshes.
+Reading: at 1.3·10⁶ faces ddgjax is 1.6× faster than libigl on the sheared torus, 2.5× on the
+stretched ellipsoid and 1.9× on the sphere, and 8–18× faster than robust-laplacian.  The flip
+phase costs 180–250 ns per flip at 1.3·10⁶ faces (a second `--large` run the same day: 185 and
+247); the vectorised numpy rounds it replaced cost 488 (ellipsoid) and 321 (torus) ns per flip
+in a `--large` run the same day.  Of the flip phase, the compiled loop itself takes 95–150 ns
+per flip (timed alone on the same machine), the two derived-cotangent kernels (the autodiff
+Hessian of the Dirichlet energy, of the start and of the result) about 0.15–0.2 s together,
+i.e. 60–100 ns per flip on these meshes.
+"rounds" is the longest cascade of flips (`FlipResult.n_rounds`).  Time grows about linearly;
+meshes whose vertex labels are not spatially coherent are renumbered along a Morton curve first
+(`ddgjax.intrinsic.ordering`), for cache locality.  Results do not depend on the flip order
+beyond rounding: where two diagonals of a cocircular quadrilateral are both Delaunay (the
+symmetric ellipsoid) the kept one may differ, and its cotan weight is 0 to rounding either way.
+`--large` runs only the 1.3·10⁶-face meshes.
 """
 
 from __future__ import annotations

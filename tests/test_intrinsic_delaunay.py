@@ -1,5 +1,8 @@
 """Delaunay edges, the flip algorithm and the harmonic index (Sec 7.2, 7.3), Rippa's lemma."""
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -241,3 +244,25 @@ def test_flipping_in_place_equals_flipping_a_copy():
     for a, b in zip((copied.F, copied.triangulation.edge, copied.triangulation.halfedges, copied.lengths),
                     (in_place.F, in_place.triangulation.edge, in_place.triangulation.halfedges, in_place.lengths)):
         np.testing.assert_array_equal(a, b)
+
+
+def test_compiled_flip_writes_what_lemma_5_8_flip_writes():
+    """The compiled loop's flip (`flip_algorithm`) and `flips.flip` give the same gluing and the
+    same length of the new diagonal, on a triangulation needing exactly one flip."""
+    V = np.array([[-1, 0, 0], [1, 0, 0], [0, 0.2, 0], [0, 0.1, 0.01]], float)
+    F = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])
+    tri = T.from_mesh(V, F)
+    (e,) = np.flatnonzero(~dg.intrinsic.delaunay_edges(tri))
+    result = dg.intrinsic.flip_to_delaunay(tri)
+    single = dg.intrinsic.flip(tri, int(e))
+    assert result.n_flips == 1
+    for a, b in ((result.F, single.F), (result.triangulation.edge, single.edge),
+                 (result.triangulation.halfedges, single.halfedges)):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_allclose(result.lengths, single.lengths, rtol=4e-16)
+
+
+def test_import_ddgjax_does_not_load_numba():
+    """numba (the compiled flip loop) is loaded by the first flip, not by `import ddgjax`."""
+    code = "import sys, ddgjax, ddgjax.intrinsic; assert 'numba' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)

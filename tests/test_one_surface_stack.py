@@ -46,9 +46,9 @@ def law_of_cosines_sites(path: Path) -> list[tuple[str, str]]:
 
 
 def test_one_connectivity_type():
-    # `_Work` (intrinsic/delaunay.py) is the flip loop's mutable buffer of one `Halfedges`' arrays,
-    # turned back into `Halfedges` by `triangulation.of_arrays`; not a connectivity type of its own
-    assert sorted(c for p in SOURCES for c in connectivity_classes(p)) == ["Halfedges", "_Work"]
+    # the flip loop works on the flat arrays of one `Halfedges` and turns them back into one
+    # (`triangulation.of_arrays`); it has no class of its own
+    assert sorted(c for p in SOURCES for c in connectivity_classes(p)) == ["Halfedges"]
 
 
 def test_no_cotangent_formula_outside_the_angle_criterion():

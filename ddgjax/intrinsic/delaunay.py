@@ -6,22 +6,16 @@
   it strictly decreases at every flip of a non-Delaunay edge (Cor 7.16, 7.19) and is proper
   (Lemma 7.20), so the flip algorithm terminates (Thm 7.12), also on triangulations with
   arbitrarily long edges (Example 7.3).
-- The edge-flip algorithm (Fig 7.13) driven by a queue of edges to test, vectorised with numpy
-  over batches of `CHUNK` queued edges: test every edge of the batch, choose among the
-  non-Delaunay ones an independent set (no two share a triangle: the edge of smallest fixed
-  pseudo-random priority, a hash of its index, in each of its triangles), flip them all at once
-  (`flips.flip_batch`, equal to flipping them one after another), and queue the not-chosen ones
-  and those of the four outer edges of every flipped quadrilateral that fail the test after the
-  batch (an edge whose triangles change again later is tested again by that later flip, so the
-  queue always holds every edge that may be non-Delaunay).  Every flip is one step of Fig 7.13,
-  recorded in the history.  The test keys cot + tol · s of all corners and the areas of all
-  faces are cached and updated at each flip, so a test is four array lookups.  The keys of
-  the start and the cotan weights of the result are the derived ones (`triangulation.
-  halfedge_cotangents`: the autodiff Hessian of the Dirichlet energy); the keys of the triangles
-  a flip creates come from the law of cosines (`ddgjax.mesh.lengths.corner_cotangents`), one
-  vectorised expression per round.  The flip loop itself is not jitted: numpy's vectorised
-  gathers and scatters, where scattered writes and boolean compressions are the cost, so a flip writes as
-  few entries as it can (`flips.flip_batch`).
+- The edge-flip algorithm (Fig 7.13) as a sequential loop compiled by numba
+  (`flip_algorithm`): a sweep over the edges; a non-Delaunay edge found by the sweep is flipped,
+  and those of the four outer edges of its quadrilateral that then fail the test are tested and
+  flipped depth-first (a stack), so that every non-Delaunay edge is on the stack or not yet
+  swept.  Every flip is one step of Fig 7.13, recorded in the history.  The test keys
+  cot + tol · s of all corners and the areas of all faces are cached and updated at each flip,
+  so a test is two lookups.  The keys of the start and the cotan weights of the result are the
+  derived ones (`triangulation.halfedge_cotangents`: the autodiff Hessian of the Dirichlet
+  energy); the keys of the triangles a flip creates come from the law of cosines
+  (`ddgjax.mesh.lengths.corner_cotangents`).
 
 Surfaces with boundary (which the reference does not treat) keep their boundary edges; only
 interior edges are tested and flipped, as in libigl's `intrinsic_delaunay_triangulation`.
@@ -40,14 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FlipBudgetError, InvalidInputError
-from ..mesh.lengths import corner_cotangents, face_harmonic_index, side_cotangents, triangle_area
-from .flips import flip_batch, others
-from .geometry import flipped_length
+from ..mesh.lengths import face_harmonic_index, side_cotangents, triangle_area
 from .triangulation import (
     Triangulation,
     cotan_weights,
-    halfedge_cotangents,
     from_faces,
+    halfedge_cotangents,
     of_arrays,
     side_lengths,
 )
@@ -65,7 +57,6 @@ __all__ = [
 ]
 
 DELAUNAY_TOL = 1e-12
-CHUNK = 1 << 15  # queue entries per vectorised batch: small enough that temporaries stay in cache
 
 
 def as_triangulation(F, lengths=None) -> Triangulation:
@@ -139,7 +130,8 @@ class FlipResult:
     """Outcome of `flip_to_delaunay`.
 
     **Fields:** `triangulation` (the Delaunay triangulation; faces, gluing and lengths);
-    `n_flips`; `n_rounds` (vectorised rounds of independent flips); `harmonic_index`
+    `n_flips`; `n_rounds` (the longest cascade of flips, each of an edge that the one before
+    made non-Delaunay; `flip_algorithm.flip_algorithm`); `harmonic_index`
     ((n_flips + 1,) h(T) before the first and after every flip, or just the first and last value
     when the history was not recorded); `harmonic_index_steps` ((n_flips,) the change of h at each
     flip, all < 0 by Cor 7.19; empty when not recorded); `halfedge_cotangents` ((3 nf,) the cot
@@ -174,140 +166,14 @@ class FlipResult:
         return self.triangulation.edges
 
 
-@dataclass(eq=False)
-class _Work:
-    """Mutable working copy for the flip loop: the flat gluing arrays; per halfedge the test key
-    cot + tol · s(face) of the opposite angle (one more entry, +inf, read by the boundary's
-    halfedge -1, so that boundary edges always pass), per face its area (kept up to date at each
-    flip, so that the test of an edge, key(h) + key(t) < 0, is four lookups).  The derived
-    cotangents of the result are computed once at the end."""
-
-    F: np.ndarray
-    edge: np.ndarray
-    halfedges: np.ndarray
-    lengths: np.ndarray
-    key: np.ndarray
-    area: np.ndarray
-    scratch: np.ndarray
-    tol: float
-
-    @classmethod
-    def of(cls, tri: Triangulation, tol: float, geometry, copy: bool = True) -> _Work:
-        """The working copy (`copy=False`: work in the arrays of `tri`, which the caller owns)."""
-        cots, A, scales = geometry
-        key = np.empty(cots.size + 1)
-        np.add(cots.reshape(-1, 3), tol * scales[:, None], out=key[:-1].reshape(-1, 3))
-        key[-1] = np.inf
-        arrays = (tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths)
-        if copy:
-            arrays = tuple(a.copy() for a in arrays)
-        return cls(*arrays, key, A, np.full(tri.n_edges, _NONE, dtype=np.int64), tol)
-
-    def arrays(self):
-        return self.F, self.edge, self.halfedges, self.lengths
-
-
-def _failing(w: _Work, e):
-    """bool mask over the edges `e`: the angle test fails (Prop 7.9 with the tie tolerance:
-    cot α + tol s₁ + cot β + tol s₂ < 0), read from the cached keys."""
-    return w.key[w.halfedges[:, 0][e]] + w.key[w.halfedges[:, 1][e]] < 0
-
-
-_NONE = np.iinfo(np.int64).max
-
-
-def _priority(e):
-    """A fixed pseudo-random priority, distinct for distinct edges: Knuth's multiplicative hash,
-    a bijection of the 32-bit integers."""
-    return (e * 2654435761) & 0xFFFFFFFF
-
-
-def _independent(bad, sides, scratch) -> np.ndarray:
-    """bool mask over `bad` (distinct edges): the edges of least priority among the non-Delaunay
-    edges of both of their triangles (`sides`: the four other edges of those triangles)."""
-    own = _priority(bad)
-    scratch[bad] = own
-    best = own
-    for side in sides:
-        best = np.minimum(best, scratch[side])
-    scratch[bad] = _NONE
-    return own == best
-
-
-def _unique(e: np.ndarray, scratch_marks: np.ndarray) -> np.ndarray:
-    """The distinct entries of e, in O(len e) with a scratch array (the last occurrence wins)."""
-    position = np.arange(e.size)
-    scratch_marks[e] = position
-    return e[scratch_marks[e] == position]
-
-
-def _sums_of_squares(x, y, z, area):
-    """s = (x² + y² + z²) / 4A = h(Δ)/4 (Def 7.7, Lemma 7.17) and the squares."""
-    x2, y2, z2 = x * x, y * y, z * z
-    return (x2 + y2 + z2) / (4.0 * area), (x2, y2, z2)
-
-
-def _new_face_keys(w: _Work, slots, face, x, y, z):
-    """Store the area of the new faces with sides x, y, z on `slots` (in order) and the keys
-    cot + tol · s of the angles opposite them (cot opposite x = (y² + z² − x²)/4A); returns s
-    and the three keys."""
-    B = triangle_area(x, y, z)
-    w.area[face] = B
-    s, (x2, y2, z2) = _sums_of_squares(x, y, z, B)
-    shift = w.tol * s
-    keys = []
-    for slot, cot in zip(slots, corner_cotangents(x2, y2, z2, B)):
-        w.key[slot] = k = cot + shift
-        keys.append(k)
-    return s, keys
-
-
-def _flip_round(w: _Work, queue, record):
-    """Test the distinct edges `queue`, flip an independent set of the non-Delaunay ones (no
-    two share a triangle; the other non-Delaunay ones wait for the next round).  Returns (number
-    of flips, harmonic-index steps or None, edges to test next: the non-Delaunay ones not
-    flipped and the sides of the flipped quadrilaterals that fail the test after the whole
-    batch; a side whose triangles change again later is tested again by that flip).  Boundary
-    edges pass the test (key +inf), and so does an edge lying twice on one triangle (its two
-    opposite angles are equal and acute); the `f != g` guard only protects against rounding
-    (such an edge is dropped, never flipped, so that a round cannot stall)."""
-    e = queue[_failing(w, queue)]
-    if e.size == 0:
-        return 0, None, e
-    F, edge, halfedges, lengths = w.arrays()
-    h, t = halfedges[:, 0][e], halfedges[:, 1][e]
-    f, g = h // 3, t // 3
-    h1, h2 = others(h, f)
-    t1, t2 = others(t, g)
-    sides = (edge[h1], edge[h2], edge[t1], edge[t2])
-    distinct = f != g
-    chosen = _independent(e, sides, w.scratch) & distinct
-    rest = e[~chosen & distinct]  # (an edge twice on one triangle is never flipped: not kept)
-    if not chosen.all():
-        e, h, t = e[chosen], h[chosen], t[chosen]
-        sides = tuple(x[chosen] for x in sides)
-        f, g = h // 3, t // 3
-        h1, h2 = others(h, f)
-        t1, t2 = others(t, g)
-    l_ab = lengths[e]
-    l_bc, l_ca, l_ad, l_db = (lengths[x] for x in sides)
-    A1, A2 = w.area[f], w.area[g]
-    new = flipped_length(l_ab, l_bc, l_ca, l_ad, l_db, A1, A2)
-    flip_batch(F, edge, halfedges, lengths, e, ((h, h1, h2, t, t1, t2), sides), new)
-    # (a, d, c) on h, h1, h2 with sides ad, dc, ca and (b, c, d) on t, t1, t2 with bc, cd, db
-    s_f, (k_ad, _, k_ca) = _new_face_keys(w, (h, h1, h2), f, l_ad, new, l_ca)
-    s_g, (k_bc, _, k_db) = _new_face_keys(w, (t, t1, t2), g, l_bc, new, l_db)
-    steps = None
-    if record:
-        before = _sums_of_squares(l_ab, l_bc, l_ca, A1)[0] + _sums_of_squares(l_ab, l_ad, l_db, A2)[0]
-        steps = 4.0 * (s_f + s_g - before)
-    # the sides that now fail: own key (just computed) + key of the other halfedge (the other
-    # column of halfedges[side]; -1 on the boundary, whose key is +inf)
-    H0, H1 = halfedges[:, 0], halfedges[:, 1]
-    pushed = [rest]
-    for x, slot, k in zip(sides, (t, h2, h, t2), (k_bc, k_ca, k_ad, k_db)):
-        pushed.append(x[k + w.key[H0[x] + H1[x] - slot] < 0])
-    return e.size, steps, np.concatenate(pushed)
+def _test_keys(cots, scales, tol: float) -> np.ndarray:
+    """(3 nf + 1,) per halfedge the test key cot + tol · s(face) of the angle opposite it, and
+    one more entry, +inf, read by the boundary's halfedge -1 (so that boundary edges always
+    pass): the test of an edge is key(h) + key(t) < 0 (Prop 7.9 with the tie tolerance)."""
+    key = np.empty(cots.size + 1)
+    np.add(cots.reshape(-1, 3), tol * scales[:, None], out=key[:-1].reshape(-1, 3))
+    key[-1] = np.inf
+    return key
 
 
 def flip_to_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL, max_flips: int | None = None,
@@ -330,34 +196,28 @@ def flip_owned(tri: Triangulation, tol: float = DELAUNAY_TOL, max_flips: int | N
                record_history: bool = False, copy: bool = False) -> FlipResult:
     """`flip_to_delaunay` of a triangulation whose arrays the caller owns: with `copy=False` they
     are flipped in place (and `tri` must not be used afterwards)."""
+    # numba is loaded here, not at `import ddgjax`; the loop is compiled once per machine
+    from .flip_algorithm import flip_algorithm
+
     budget = 50 * tri.n_faces + 1000 if max_flips is None else int(max_flips)
-    geometry = _face_geometry(tri)
-    w = _Work.of(tri, tol, geometry, copy)
-    marks = np.zeros(tri.n_edges, dtype=np.int64)
-    queue = np.flatnonzero(_failing(w, slice(None)))  # boundary edges pass (key +inf)
-    h0 = 4.0 * float(geometry[2].sum())
-    steps, n_flips, n_rounds = [], 0, 0
-    while queue.size:
-        parts, before = [], n_flips
-        for start in range(0, queue.size, CHUNK):
-            flipped, step, more = _flip_round(w, queue[start:start + CHUNK], record_history)
-            n_flips += flipped
-            parts.append(more)
-            if step is not None:
-                steps.append(step)
-            if n_flips > budget:
-                raise FlipBudgetError(
-                    f"flip budget of {budget} flips used up after {n_rounds} rounds; edge "
-                    f"{more[0] if more.size else queue[start]} is still not Delaunay (raise max_flips, or "
-                    "check the lengths for near-degenerate triangles)"
-                )
-        queue = _unique(np.concatenate(parts), marks)
-        n_rounds += n_flips > before
-    out, cots = tri, geometry[0]
+    cots, area, scales = _face_geometry(tri)
+    arrays = tuple(np.ascontiguousarray(a) for a in (tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths))
+    if copy:
+        arrays = tuple(a.copy() for a in arrays)
+    n_flips, n_rounds, steps, stuck = flip_algorithm(*arrays, _test_keys(cots, scales, tol), area, float(tol),
+                                                     budget, bool(record_history))
+    if stuck >= 0:
+        raise FlipBudgetError(
+            f"flip budget of {budget} flips used up; edge {stuck} is still not Delaunay (raise "
+            "max_flips, or check the lengths for near-degenerate triangles)"
+        )
+    h0 = 4.0 * float(scales.sum())
+    out = tri
     if n_flips:  # the derived cotangents of the new triangles (the keys hold the law of cosines)
-        out = of_arrays(w.F, w.edge, w.halfedges, w.lengths, tri.n_vertices)
+        out = of_arrays(*arrays, tri.n_vertices)
         cots = halfedge_cotangents(out)
-    scales = cots.reshape(-1, 3).sum(axis=1)
-    steps = np.concatenate(steps) if steps else np.zeros(0)
-    history = h0 + np.concatenate([[0.0], np.cumsum(steps)]) if record_history else np.array([h0, 4.0 * float(scales.sum())])
-    return FlipResult(out, n_flips, n_rounds, history, steps, cots)
+    if record_history:
+        history = h0 + np.concatenate([[0.0], np.cumsum(steps)])
+    else:
+        history = np.array([h0, 4.0 * float(cots.reshape(-1, 3).sum(axis=1).sum())])
+    return FlipResult(out, int(n_flips), int(n_rounds), history, steps, cots)
