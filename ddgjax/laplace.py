@@ -36,11 +36,10 @@ from jaxtyping import Array, Float, Int
 from .errors import (
     DegenerateFaceError,
     InvalidInputError,
-    MeshError,
     NonFiniteError,
     ShapeError,
 )
-from .mesh.connectivity import boundary_indices, from_faces
+from .mesh.connectivity import boundary_indices, checked_triangles, from_faces
 from .mesh.lengths import (
     corner_weights,
     dirichlet_energy,
@@ -101,27 +100,16 @@ def _as_positions(V) -> np.ndarray:
     return V
 
 
-def _as_triangles(F, n_vertices: int) -> np.ndarray:
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3 or not np.issubdtype(F.dtype, np.integer):
-        raise ShapeError(f"F must be an (nf, 3) integer array of triangles, got {F.dtype} {F.shape}")
-    out = (F < 0) | (F >= n_vertices)
-    if out.any():
-        f = int(np.argmax(out.any(axis=1)))
-        raise MeshError(f"face {f} {F[f].tolist()} has a vertex index outside 0..{n_vertices - 1}")
-    return F.astype(np.int64)
-
-
 def checked_triangle_mesh(V, F, *, manifold: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """`(V, F)` as float64 (nv, 3) and int64 (nf, 3) arrays, validated (the inputs are not changed).
 
     **Raises:** `ShapeError` (shapes), `NonFiniteError` (NaN/inf position, naming the vertex),
-    `MeshError` (index out of range, naming the face); with `manifold=True` also the checks of
+    `MeshError` (an index out of range or a repeated vertex, naming the face: `mesh.checked_triangles`); with `manifold=True` also the checks of
     `mesh.from_faces` (`NonManifoldError` naming the edge or vertex, a face repeating a vertex).
     Zero-area faces are detected where the geometry is computed (`DegenerateFaceError`).
     """
     V = _as_positions(V)
-    F = _as_triangles(F, V.shape[0])
+    F, _ = checked_triangles(F, V.shape[0])
     if manifold:
         from_faces(F, n_vertices=V.shape[0])
     return V, F
