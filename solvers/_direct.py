@@ -33,6 +33,7 @@ Factorisers (`factoriser=`), chosen by measurement (`benchmarks/linear_solvers.p
 
 from __future__ import annotations
 
+import functools
 import threading
 from dataclasses import dataclass, field
 
@@ -58,7 +59,8 @@ def _csc_structure(pattern: SparsePattern) -> tuple[np.ndarray, np.ndarray]:
     return indptr, pattern.cols.astype(np.int64)
 
 
-def _cholmod_available() -> bool:
+@functools.cache
+def cholmod_available() -> bool:
     try:
         import sksparse.cholmod  # noqa: F401
     except ImportError:
@@ -195,8 +197,8 @@ class SparseDirect(AssembledSparse):
         if factoriser not in FACTORISERS:
             raise InvalidInputError(f"factoriser must be one of {FACTORISERS}, got {factoriser!r}")
         if factoriser == "auto":
-            factoriser = "cholmod" if _cholmod_available() else "superlu"
-        if factoriser == "cholmod" and not _cholmod_available():
+            factoriser = "cholmod" if cholmod_available() else "superlu"
+        if factoriser == "cholmod" and not cholmod_available():
             raise InvalidInputError("factoriser='cholmod' needs scikit-sparse (pip install scikit-sparse)")
         self.factoriser = factoriser
         super().__init__(pattern, index)

@@ -33,7 +33,7 @@ from ddgjax.errors import ConvergenceError, InvalidInputError
 from ddgjax.problem import Problem
 
 from ._dense import DenseLU
-from ._direct import SparseDirect
+from ._direct import SparseDirect, cholmod_available
 from ._kkt import KKT, residual_weights, scaled_residual, spec_of
 from ._solve import Solution, linear_solver_of, solve
 
@@ -100,8 +100,8 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
     converge to a saddle.
 
     **Arguments:** `tol` on the scaled max-norm gradient (as `solve`); `max_steps` Newton steps;
-    `linear_solver` `SparseDirect()` (default for a problem declared local, CPU) or `DenseLU()`
-    (otherwise; inertia from the eigenvalues, for small problems); `throw` raise
+    `linear_solver` `SparseDirect()` (default for a problem declared local, with CHOLMOD) or
+    `DenseLU()` (otherwise; inertia from the eigenvalues, for small problems); `throw` raise
     `ConvergenceError` when not converged.
 
     **Returns:** a `Solution` (`steps` and `history` of this minimisation; differentiable in the
@@ -117,7 +117,10 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
             "problems use solve and check the index of the solution"
         )
     if linear_solver is None:
-        linear_solver = SparseDirect() if spec.is_local else DenseLU()
+        linear_solver = SparseDirect() if spec.is_local and cholmod_available() else DenseLU()
+    if isinstance(linear_solver, SparseDirect) and linear_solver.factoriser != "cholmod":
+        raise InvalidInputError("minimize needs the inertia of CHOLMOD's LDLᵀ: SparseDirect(factoriser='cholmod') "
+                                "(pip install scikit-sparse) or DenseLU()")
     if not isinstance(linear_solver, (SparseDirect, DenseLU)):
         raise InvalidInputError(f"minimize needs the inertia of the Hessian: SparseDirect() or DenseLU(), got {linear_solver!r}")
     linear = linear_solver_of(problem, spec, "auto", linear_solver)

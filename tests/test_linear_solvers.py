@@ -6,12 +6,15 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+
 import ddgjax as dg
 from ddgjax.errors import InvalidInputError
 from energies import area, elastica
 from solvers import KLU, DenseLU, Krylov, LinearSolver, SparseDirect, solve, solve_batch
-from ddgjax.problem import flatten_multipliers
+from solvers._direct import cholmod_available
 from solvers._kkt import KKT, spec_of
+
+needs_cholmod = pytest.mark.skipif(not cholmod_available(), reason="scikit-sparse (CHOLMOD) not installed")
 
 CLAMPED = dict(chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
 BACK_ENDS = [DenseLU(), KLU(), SparseDirect(), SparseDirect(factoriser="superlu"), Krylov()]
@@ -56,6 +59,7 @@ def test_sparse_back_ends_agree_on_a_minimal_surface(linear):
     assert np.max(np.abs(np.asarray(sol.x) - np.asarray(ref.x))) <= 1e-10
 
 
+@needs_cholmod
 def test_method_sparse_takes_klu_on_chains_and_sparse_direct_on_meshes():
     from solvers._solve import linear_solver_of
 
@@ -85,6 +89,7 @@ def test_gradient_and_batch_through_sparse_direct(reference):
         assert np.max(np.abs(np.asarray(batch.x[k]) - np.asarray(one.x))) <= 1e-12
 
 
+@needs_cholmod
 def test_ldl_inertia_counts_negative_eigenvalues():
     """Sylvester's law: the negative pivots of `LDLᵀ` count the negative eigenvalues, here of the
     area Hessian shifted between its 3rd and 4th eigenvalue (three negative ones)."""
