@@ -1,4 +1,6 @@
-"""Simplicial area and minimal surfaces (Sec 6.4, Thm 6.7, Fig 6.5, Fig 6.6 / eq 6.3)."""
+"""Simplicial area and minimal surfaces (Sec 6.4): `energies.area`'s entry points, their methods,
+errors and plots.  Thm 6.7, the catenoid of Fig 6.5 (criticality, order of the neck, the Newton
+polish) and Fig 6.6 are `ddgjax verify` checks (`sec6_laplace`)."""
 
 import jax
 import numpy as np
@@ -14,32 +16,11 @@ from ddgjax.errors import (
     NonManifoldError,
 )
 from ddgjax.verify import references
-from energies import area, dirichlet
+from energies import area
 
 
 def jittered(V, seed, scale=0.05):
     return V + scale * np.random.default_rng(seed).normal(size=V.shape)
-
-
-MESHES = {
-    "disk": lambda: (jittered(dg.mesh.disk(3, 10)[0], 0), dg.mesh.disk(3, 10)[1]),
-    "icosphere": lambda: (jittered(dg.mesh.icosphere(1)[0], 1), dg.mesh.icosphere(1)[1]),
-}
-
-
-@pytest.mark.parametrize("name", MESHES)
-def test_thm_6_7_area_and_its_gradient(name):
-    """A(S) = Σ_k E(f_k) and ∇A = L f (Thm 6.7), by autodiff of the declared area."""
-    V, F = MESHES[name]()
-    problem = area.simplicial(V, F, [0])
-    A = float(problem.energy(V, None))
-    coordinate = dirichlet.cotan(V, F, [0], [0.0])
-    dirichlet_energy = jax.jit(coordinate.energy)
-    energies = [float(dirichlet_energy(V[:, k], coordinate.params)) for k in range(3)]
-    assert abs(A - sum(energies)) < 1e-12 * A
-    assert abs(A - float(dg.mesh.surface_area(V, F))) < 1e-12 * A
-    gradient = np.asarray(jax.jit(jax.grad(problem.energy))(V, None))
-    assert np.max(np.abs(gradient - dg.laplace.cotan_laplacian(V, F) @ V)) < 1e-12
 
 
 # The catenoid between the coaxial circles of radius R at z = ±H.
@@ -50,37 +31,6 @@ def cylinder(n, R=1.0, H=0.5):
     V, F = dg.mesh.annulus(3 * n, n + 1, 1.0, 2.0)
     t, s = np.arctan2(V[:, 1], V[:, 0]), np.linalg.norm(V[:, :2], axis=1) - 1.0
     return np.stack([R * np.cos(t), R * np.sin(t), H * (2 * s - 1)], 1), F
-
-
-def neck_error(n):
-    """|min_i r_i − c| after Fig 6.5 to an area-gradient residual 0.05 h⁴ (h ∝ 1/n: the
-    gradient is O(h²) per vertex and the geometry must settle well below the O(h²) error)."""
-    V, F = cylinder(n)
-    V, F, _ = area.minimal_surface(V, F, tol=0.05 / n**4, max_iter=2000)
-    return abs(references.neck_radius(V) - references.catenoid_neck())
-
-
-@pytest.mark.parametrize("ns", [[6, 8, 12, 16], pytest.param([8, 16, 24, 32], marks=pytest.mark.slow)])
-def test_catenoid_neck_converges_order_two(ns):
-    """Fig 6.5 on the cylinder: the neck radius converges to the catenoid's, O(h²)."""
-    table = dg.limits.convergence(neck_error, ns, label="|neck − c|")
-    print("\n" + table.to_markdown())
-    assert abs(table.fitted_order - 2.0) < 0.3
-
-
-@pytest.mark.slow
-def test_newton_polishes_the_cotan_iterate():
-    """Pinkall–Polthier stalls into slow tangential creep; Newton on the area (through `solve`)
-    from its iterate reaches a critical point in a few steps, and both agree to their residuals."""
-    V, F = cylinder(4)
-    V1, _, info1 = area.minimal_surface(V, F, tol=1e-6)
-    V2, _, info2 = area.minimal_surface(V1, F, method="newton", tol=1e-11)
-    assert info2["converged"] and info2["iterations"] <= 5
-    L = dg.laplace.cotan_laplacian(V2, F)
-    interior = np.setdiff1d(np.arange(len(V)), dg.mesh.boundary_vertices(F, len(V)))
-    assert np.max(np.abs((L @ V2)[interior])) < 1e-11
-    assert np.max(np.abs(V2 - V1)) < 1e-3
-    assert info1["area"][-1] < info1["area"][0]
 
 
 def test_planar_boundary_gives_a_planar_surface():
@@ -104,20 +54,13 @@ def fig_6_6_star(h, r=0.3, s=1.0):
     return np.vstack([[0.0, 0.0, h], ring]), F
 
 
-def test_fig_6_6_minimal_vertex_outside_convex_hull():
-    """A simplicial minimal surface (∇A = L f = 0 at its interior vertex) whose interior vertex lies
-    above all its neighbours, hence outside their convex hull: the maximum principle (Prop 6.8)
-    fails because three cotan weights are negative (eq 6.3: α_ij + α_ji > π)."""
+def test_newton_finds_the_fig_6_6_star_from_a_perturbed_start():
+    """Newton on the area functional (`minimal_surface(method="newton")`, through `solve`) finds the
+    Fig 6.6 star, a critical point with negative weights outside the convex hull of its
+    neighbours, from a perturbed start (the statements are `ddgjax verify` checks)."""
     z_gradient = lambda h: (dg.laplace.cotan_laplacian(*fig_6_6_star(h)) @ fig_6_6_star(h)[0])[0, 2]
     h = brentq(z_gradient, 1.02, 1.1, xtol=1e-15)
     V, F = fig_6_6_star(h)
-    assert np.max(np.abs((dg.laplace.cotan_laplacian(V, F) @ V)[0])) < 1e-12  # critical (C3 symmetry: x, y)
-    assert V[0, 2] > V[1:, 2].max() + 0.02  # outside the convex hull of the neighbours
-    weights = dg.laplace.cotan_weights(V, F).toarray()[0, 1:]
-    assert np.all(weights[::2] < -0.1) and np.all(weights[1::2] > 0)
-    alpha = np.asarray(dg.mesh.corner_angles(V, F))
-    assert alpha[0, 2] + alpha[-1, 1] > np.pi  # the two angles opposite the spoke (0, 1)
-    # Newton on the area functional (through `solve`) finds it from a perturbed start
     start = V.copy()
     start[0] += [0.02, -0.01, 0.03]
     V_newton, _, info = area.minimal_surface(start, F, method="newton", tol=1e-12)

@@ -13,6 +13,7 @@ import ddgjax as dg
 from ddgjax import intrinsic
 from ddgjax.intrinsic import rippa
 from ddgjax.intrinsic import triangulation as T
+from ddgjax.mesh.lengths import corner_cotangents, face_harmonic_index, triangle_area
 from ddgjax.verify import check, figures
 from energies.area import interior_residual
 
@@ -23,10 +24,42 @@ def _planar_skinny(n_inner: int = 150):
     return dg.mesh.builtin.tall_dome(0, n_inner=n_inner, height=0.0)
 
 
+def _convex_quadrilateral(rng):
+    """Planar points a, b, c, d with a d b c convex: c above, d below the segment ab."""
+    while True:
+        a, b = np.array([0.0, 0.0]), np.array([rng.uniform(0.5, 2), 0.0])
+        c = np.array([rng.uniform(0.1, 1.9) * b[0], rng.uniform(0.2, 2)])
+        d = np.array([rng.uniform(0.1, 1.9) * b[0], -rng.uniform(0.2, 2)])
+        if 0.05 < d[0] + (c[0] - d[0]) * (-d[1]) / (c[1] - d[1]) < 0.95 * b[0]:  # cd crosses ab inside
+            return np.array([a, b, c, d])
+
+
+def _quadrilateral_flip_error(P) -> float:
+    """The two triangles (a, b, c), (b, a, d) of the convex planar quadrilateral P = (a, b, c, d):
+    the largest relative error of the unfolding (Lemma 5.8) against the six distances of P and of
+    the flipped edge's length against |c − d|; ∞ unless the flip gives the triangles (d, c, a), (c, d, b)."""
+    tri = T.from_mesh(np.column_stack([P, np.zeros(4)]), np.array([[0, 1, 2], [1, 0, 3]]))
+    e = int(np.flatnonzero(tri.halfedges[:, 1] >= 0)[0])
+    distances = lambda X: np.linalg.norm(X[:, None] - X[None], axis=-1)  # noqa: E731
+    D = distances(P)
+    unfolding = float(np.max(np.abs(distances(T.unfold(tri, e)) - D)) / D.max())
+    if not intrinsic.is_flippable(tri, e):
+        return float("inf")
+    flipped = intrinsic.flip(tri, e)
+    if sorted(map(sorted, flipped.F.tolist())) != [[0, 2, 3], [1, 2, 3]]:
+        return float("inf")
+    return max(unfolding, abs(flipped.lengths[e] - D[2, 3]) / D[2, 3])
+
+
 @check("Lemma 5.8", "flipping an edge of a flat surface gives the other diagonal of the unfolded quadrilateral",
-       quantity="max over all flippable edges of |l(flipped) − |v_c − v_d|| / l, and of the change of cone angles",
-       at_most=1e-10, quick=dict(n_inner=60), full=dict(n_inner=300))
-def flip_length_is_the_other_diagonal(ctx, n_inner):
+       quantity="max over all flippable edges of a skinny flat disk of |l(flipped) − |v_c − v_d|| / l and of the change "
+       "of cone angles (∞ unless on random convex quadrilaterals the unfolding, the new diagonal and the new faces are "
+       "right to 1e-13)", at_most=1e-10, quick=dict(n_inner=60, quadrilaterals=20),
+       full=dict(n_inner=300, quadrilaterals=200))
+def flip_length_is_the_other_diagonal(ctx, n_inner, quadrilaterals):
+    rng = np.random.default_rng(0)
+    if max(_quadrilateral_flip_error(_convex_quadrilateral(rng)) for _ in range(quadrilaterals)) > 1e-13:
+        return float("inf")
     V, F, _ = _planar_skinny(n_inner)
     tri = T.from_mesh(V, F)
     cones = T.cone_angles(tri)
@@ -55,12 +88,19 @@ def _flipped(level: int, bumps: float = 0.0):
     return tri, intrinsic.flip_to_delaunay(tri)
 
 
-@check("Prop 7.9, Thm 7.12", "the flip algorithm terminates on a skinny ellipsoid with α + β ≤ π at every edge",
-       quantity="max over edges of α + β − π after flipping", at_most=1e-12, quick=dict(level=2), full=dict(level=4))
+@check("Prop 7.9, Thm 7.12", "the flip algorithm terminates on a skinny ellipsoid (symmetric, and with bumps) with "
+       "α + β ≤ π at every edge, and keeps the metric (the cone angles)",
+       quantity="max over edges of α + β − π after flipping, and of the change of the cone angles", at_most=1e-12,
+       quick=dict(level=2), full=dict(level=4))
 def flips_reach_angle_criterion(ctx, level):
-    _, result = _flipped(level)
-    excess = float(np.max(_opposite_angle_sums(result.triangulation)) - np.pi)
-    return excess if result.n_flips > 0 and intrinsic.is_delaunay(result) else float("inf")
+    worst = 0.0
+    for bumps in (0.0, 0.1):
+        tri, result = _flipped(level, bumps)
+        if result.n_flips <= 10 or not intrinsic.is_delaunay(result):
+            return float("inf")
+        worst = max(worst, float(np.max(_opposite_angle_sums(result.triangulation)) - np.pi),
+                    float(np.max(np.abs(T.cone_angles(result.triangulation) - T.cone_angles(tri)))))
+    return worst
 
 
 @check("Prop 7.9", "negative control: before flipping, the skinny ellipsoid has edges with α + β > π",
@@ -71,10 +111,14 @@ def skinny_start_violates_angle_criterion(ctx, level):
 
 
 @check("Prop 7.10", "the cotan weights of the Delaunay triangulation are ≥ 0",
-       quantity="max(0, −min ν) / max ν after flipping", at_most=1e-12, quick=dict(level=2), full=dict(level=4))
+       quantity="max(0, −min ν) / max ν after flipping (skinny ellipsoid, symmetric and with bumps)", at_most=1e-12,
+       quick=dict(level=2), full=dict(level=4))
 def delaunay_weights_nonnegative(ctx, level):
-    nu = _flipped(level)[1].cotan_weights()
-    return max(0.0, -float(nu.min())) / float(nu.max())
+    worst = 0.0
+    for bumps in (0.0, 0.1):
+        nu = _flipped(level, bumps)[1].cotan_weights()
+        worst = max(worst, -float(nu.min()) / float(nu.max()))
+    return worst
 
 
 @check("Prop 7.10, eq (6.3)", "negative control: the start triangulation (not Delaunay) has negative cotan weights",
@@ -84,16 +128,32 @@ def start_weights_negative(ctx, level):
     return -float(nu.min()) / float(nu.max())
 
 
-@check("Cor 7.19, Lemma 7.18", "the harmonic index h(T) strictly decreases at every flip, and h = 8 Σ E(φ_i) = 4 tr L",
-       quantity="max over flips of Δh / h(T_0), plus |h − 4 tr L| / h at the end", at_most=-1e-12,
-       quick=dict(level=2), full=dict(level=4))
-def harmonic_index_decreases(ctx, level):
+def _lemma_7_17_error(count: int) -> float:
+    """max relative error of h(Δ) = (a² + b² + c²) / A = 4 (cot α + cot β + cot γ) over random triangles."""
+    rng = np.random.default_rng(0)
+    a, b = rng.uniform(0.5, 2, count), rng.uniform(0.5, 2, count)
+    c = rng.uniform(np.abs(a - b) + 0.01, a + b - 0.01)
+    A = triangle_area(a, b, c)
+    h, cots = face_harmonic_index(a, b, c, A), 4 * sum(corner_cotangents(a * a, b * b, c * c, A))
+    return float(np.max(np.abs(np.asarray(h) - np.asarray(cots)) / np.asarray(h)))
+
+
+@check("Cor 7.19, Lemma 7.17, 7.18", "the harmonic index h(T) strictly decreases at every flip; h(Δ) = 4 Σ cot on every "
+       "triangle and h(T) = 8 Σ E(φ_i) = 4 tr L before and after flipping",
+       quantity="max over flips of Δh / h(T_0) (∞ unless h(Δ) = 4 Σ cot on random triangles and h(T) = 4 tr L at both ends "
+       "agree to 1e-12 relative, and the recorded h(T_0) to 1e-14)", at_most=-1e-12, quick=dict(level=2, triangles=100),
+       full=dict(level=4, triangles=10_000))
+def harmonic_index_decreases(ctx, level, triangles):
     tri, result = _flipped(level)
     h = result.harmonic_index
-    trace = 4.0 * float(intrinsic.cotan_laplacian(result.triangulation).diagonal().sum())
-    if not result.n_flips or not np.isclose(h[0], intrinsic.harmonic_index(tri), rtol=1e-13):
+    trace = lambda t: 4.0 * float(intrinsic.cotan_laplacian(t).diagonal().sum())  # noqa: E731
+    h_start = intrinsic.harmonic_index(tri)
+    identities = max(_lemma_7_17_error(triangles), abs(h_start - trace(tri)) / h[0],
+                     abs(h[-1] - trace(result.triangulation)) / h[-1])
+    recorded = abs(h[0] - h_start) / h[0]
+    if not result.n_flips or identities > 1e-12 or recorded > 1e-14 or np.any(result.harmonic_index_steps >= 0):
         return float("inf")
-    return float(np.max(np.diff(h))) / h[0] + abs(h[-1] - trace) / h[-1]
+    return float(np.max(np.diff(h))) / h[0]
 
 
 @check("Fig 7.13, Prop 7.9", "figure: a flat disk with skinny triangles before and after flipping to Delaunay",
@@ -105,42 +165,46 @@ def flip_figure(ctx, n_inner):
     return float(np.sum(~intrinsic.delaunay_edges(result.triangulation))) if result.n_flips else float("inf")
 
 
-def _lengthen(tri, steps: int):
-    """`steps` flips ignoring the Delaunay criterion, each of the flippable edge (other than the
-    last one flipped) whose new diagonal is longest: triangulations with long edges (Example 7.3)."""
-    last = -1
+def _lengthen(tri, steps: int, seed: int):
+    """`steps` flips ignoring the Delaunay criterion, each, among up to 40 flippable edges taken in
+    a random order, of the one whose flip leaves the longest edge: triangulations with long edges
+    (Example 7.3)."""
+    rng = np.random.default_rng(seed)
     for _ in range(steps):
-        options = [(intrinsic.flip(tri, e), e) for e in range(tri.n_edges) if e != last and intrinsic.is_flippable(tri, e)]
-        tri, last = max(options, key=lambda option: option[0].lengths[option[1]])
+        options = [intrinsic.flip(tri, e) for e in rng.permutation(tri.n_edges)[:40] if intrinsic.is_flippable(tri, e)]
+        tri = max(options, key=lambda option: option.lengths.max())
     return tri
 
 
-def _laplacian_after_bad_start(V, F, steps: int) -> tuple[float, float, object]:
+def _laplacian_after_bad_start(V, F, steps: int, seed: int) -> tuple[float, float, object]:
     """From a triangulation made bad by `_lengthen`, flip to Delaunay: `(max |L − L_B|, longest
-    start edge, flip result)` with L_B the Laplace–Beltrami operator of (V, F)."""
-    bad = _lengthen(T.from_mesh(V, F), steps)
+    start edge, flip result)` with L_B the Laplace–Beltrami operator of (V, F); the error is ∞
+    unless the start is not Delaunay and the flips reach a Delaunay triangulation with h(T)
+    strictly decreasing."""
+    bad = _lengthen(T.from_mesh(V, F), steps, seed)
     result = intrinsic.flip_to_delaunay(bad)
     L = intrinsic.cotan_laplacian(result.triangulation).toarray()
-    return float(np.max(np.abs(L - intrinsic.laplace_beltrami(V, F).toarray()))), float(bad.lengths.max()), result
+    error = float(np.max(np.abs(L - intrinsic.laplace_beltrami(V, F).toarray())))
+    ok = not intrinsic.is_delaunay(bad) and intrinsic.is_delaunay(result) and np.all(np.diff(result.harmonic_index) < 0)
+    return error if ok else float("inf"), float(bad.lengths.max()), result
 
 
 @check("Example 7.2", "the tetrahedron from a bad triangulation: flips reach the Delaunay one (same Laplace–Beltrami operator)",
-       quantity="max |L(flipped) − L(Delaunay)|", at_most=1e-12, quick=dict(steps=4))
+       quantity="max |L(flipped) − L(Delaunay)|", at_most=1e-12, quick=dict(steps=6))
 def tetrahedron_from_bad_triangulation(ctx, steps):
     V, F = dg.mesh.tetrahedron()
-    error, _, result = _laplacian_after_bad_start(V, F, steps)
-    return error if result.n_flips > 0 and np.all(np.diff(result.harmonic_index) < 0) else float("inf")
+    return _laplacian_after_bad_start(V, F, steps, seed=4)[0]
 
 
-@check("Example 7.3, Lemma 7.20, Thm 7.5", "the cube triangulated with edges longer than its diameter √3: the flip "
+@check("Example 7.3, Lemma 7.20, Thm 7.5", "the cube triangulated with edges longer than 3 (its diameter is √3): the flip "
        "algorithm terminates at the unique Delaunay tessellation (six squares)",
-       quantity="max |L(flipped) − L(Delaunay)|", at_most=1e-12, quick=dict(steps=12), full=dict(steps=30))
+       quantity="max |L(flipped) − L(Delaunay)|", at_most=1e-12, quick=dict(steps=25), full=dict(steps=40))
 def cube_with_long_edges(ctx, steps):
     V, F = dg.mesh.cube(triangulated=True)
-    error, longest, result = _laplacian_after_bad_start(V, F, steps)
+    error, longest, result = _laplacian_after_bad_start(V, F, steps, seed=3)
     cells = intrinsic.delaunay_tessellation(result.triangulation)
     squares = cells.n_cells == 6 and np.all(cells.cell_size == 2)
-    return error if longest > np.sqrt(3.0) and squares else float("inf")
+    return error if longest > 3.0 and squares else float("inf")
 
 
 def _random_quadrilaterals(count: int, seed: int = 0):
@@ -159,15 +223,30 @@ def _split_energy(P, u, triangles) -> np.ndarray:
     return np.asarray(per[0] + per[1])
 
 
+def _split_energy_direct(P, u, triangles) -> np.ndarray:
+    """`_split_energy` from first principles: Σ ½ |∇u|² A over the two triangles, ∇u solved from
+    the affine interpolation of the values at the corners."""
+    total = 0.0
+    for t in map(list, triangles):
+        X = np.concatenate([P[:, t], np.ones((len(P), 3, 1))], axis=2)
+        gradient = np.linalg.solve(X, u[:, t, None])[:, :2, 0]
+        e1, e2 = P[:, t[1]] - P[:, t[0]], P[:, t[2]] - P[:, t[0]]
+        total = total + 0.25 * np.sum(gradient**2, axis=1) * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    return total
+
+
 @check("Lemma 7.14", "Rippa: E(u₁₃) − E(u₂₄) = ¼(u₀ − u₀*)²/sin θ · (r₁+r₃)(r₂+r₄)/(r₁r₂r₃r₄) · (r₁r₃ − r₂r₄)",
-       quantity="max relative error of eq (7.2) against the two energies", at_most=1e-10, quick=dict(count=200),
-       full=dict(count=5000))
+       quantity="max relative error of eq (7.2) against the two energies (by `triangle_dirichlet_energy` and by "
+       "solving for the gradients)", at_most=1e-10, quick=dict(count=200), full=dict(count=5000))
 def rippa_formula(ctx, count):
     r, theta, u = _random_quadrilaterals(count)
     P = np.stack([rippa.quadrilateral(r[k], theta[k]) for k in range(count)])
-    difference = _split_energy(P, u, [(0, 1, 2), (0, 2, 3)]) - _split_energy(P, u, [(1, 2, 3), (1, 3, 0)])
     formula = np.array([rippa.dirichlet_energy_difference(u[k], r[k], theta[k]) for k in range(count)])
-    return float(np.max(np.abs(formula - difference) / (1e-3 + np.abs(difference))))
+    worst = 0.0
+    for energy in (_split_energy, _split_energy_direct):
+        difference = energy(P, u, [(0, 1, 2), (0, 2, 3)]) - energy(P, u, [(1, 2, 3), (1, 3, 0)])
+        worst = max(worst, float(np.max(np.abs(formula - difference) / (1e-3 + np.abs(difference)))))
+    return worst
 
 
 def _diagonal_24_is_delaunay(r, theta) -> bool:
@@ -177,20 +256,32 @@ def _diagonal_24_is_delaunay(r, theta) -> bool:
     return bool(intrinsic.delaunay_edges(tri).all())
 
 
+def _diagonal_24_angle_sum(r, theta) -> float:
+    """α + β opposite the diagonal (24) of Q(r, θ): the angles at vertices 1 and 3, by arccos."""
+    Q = rippa.quadrilateral(r, theta)
+    angle = lambda p, q, x: np.arccos(np.dot(q - p, x - p) / np.linalg.norm(q - p) / np.linalg.norm(x - p))  # noqa: E731
+    return float(angle(Q[0], Q[1], Q[3]) + angle(Q[2], Q[3], Q[1]))
+
+
 @check("Lemma 7.15, Cor 7.16", "Q(r, θ) is circular iff r₁r₃ = r₂r₄, and the sign of r₁r₃ − r₂r₄ says which diagonal is Delaunay",
-       quantity="max |r₁r₃ − r₂r₄| / r₁r₃ on circles + number of sign mismatches", at_most=1e-10,
+       quantity="max |r₁r₃ − r₂r₄| / r₁r₃ on circles + number of mismatches (`is_circular` on circles; the sign against "
+       "the flip algorithm's test and against α + β ≤ π by arccos)", at_most=1e-10,
        quick=dict(count=100), full=dict(count=2000))
 def circularity_criterion(ctx, count):
     rng = np.random.default_rng(1)
-    worst = 0.0
+    worst, mismatches = 0.0, 0
     for _ in range(count):
         phi = np.sort(rng.uniform(0, 2 * np.pi, 4))  # four points on the unit circle: the chords (13), (24) meet at O
         P = np.stack([np.cos(phi), np.sin(phi)], 1)
         s = np.linalg.solve(np.column_stack([P[2] - P[0], P[1] - P[3]]), P[1] - P[0])[0]
         r = np.linalg.norm(P - (P[0] + s * (P[2] - P[0])), axis=1)
         worst = max(worst, abs(rippa.circularity(r)) / (r[0] * r[2]))
+        mismatches += not rippa.is_circular(r, rtol=1e-9)
     r, theta, _ = _random_quadrilaterals(count, seed=2)
-    mismatches = sum((rippa.circularity(r[k]) > 0) != _diagonal_24_is_delaunay(r[k], theta[k]) for k in range(count))
+    for k in range(count):
+        positive = rippa.circularity(r[k]) > 0
+        mismatches += (positive != _diagonal_24_is_delaunay(r[k], theta[k])) + (
+            positive != (_diagonal_24_angle_sum(r[k], theta[k]) <= np.pi))
     return worst + mismatches
 
 
@@ -201,7 +292,7 @@ def _dirichlet_energies(tri, f) -> np.ndarray:
 
 @check("Thm 7.21", "the Delaunay triangulation minimises the Dirichlet energy of every f among triangulations: "
        "no single flip and no random walk of 3 flips from it lowers E(f_T)",
-       quantity="min over flips, walks and 5 random f of (E(f_T) − E(f_Delaunay)) / E(f_Delaunay)", at_least=-1e-12,
+       quantity="min over flips, walks and 5 random f of (E(f_T) − E(f_Delaunay)) / E(f_Delaunay)", at_least=-1e-14,
        quick=dict(level=1, walks=10), full=dict(level=2, walks=30))
 def delaunay_minimises_dirichlet_energy(ctx, level, walks):
     tri = _flipped(level, bumps=0.1)[1].triangulation  # generic: no cocircular quadrilaterals (ties)
@@ -216,7 +307,7 @@ def delaunay_minimises_dirichlet_energy(ctx, level, walks):
             e = int(rng.choice([e for e in range(walk.n_edges) if e not in used and intrinsic.is_flippable(walk, e)]))
             walk, _ = intrinsic.flip(walk, e), used.add(e)
         others.append(walk)
-    if len(flippable) < tri.n_edges // 2:
+    if len(flippable) <= 0.8 * tri.n_edges:  # not vacuous: most edges are flipped
         return float("-inf")
     return float(min(np.min((_dirichlet_energies(t, f) - E0) / E0) for t in others))
 
@@ -234,11 +325,18 @@ def non_delaunay_flip_lowers_dirichlet_energy(ctx, level):
 
 @check("Def 7.8, Remark 7.9", "the Laplace–Beltrami operator is independent of the triangulation: the cube with either "
        "diagonals, and a flat disk's two skinny triangulations (squeezed in x or in y)",
-       quantity="max |L_a − L_b| / max |L_a|", at_most=1e-12, quick=dict(n_inner=100), full=dict(n_inner=1000))
+       quantity="max |L_a − L_b| / max |L_a| (∞ unless the cube's two triangulations differ, its operators agree to "
+       "1e-14 and its Delaunay tessellation is six squares)", at_most=1e-12, quick=dict(n_inner=100),
+       full=dict(n_inner=1000))
 def laplace_beltrami_independent_of_triangulation(ctx, n_inner):
     V, F = dg.mesh.cube()
-    cube = [intrinsic.laplace_beltrami(V, dg.mesh.triangulate(np.roll(F, k, axis=1))) for k in (0, 1)]
+    triangulations = [dg.mesh.triangulate(np.roll(F, k, axis=1)) for k in (0, 1)]
+    cube = [intrinsic.laplace_beltrami(V, G) for G in triangulations]
     disk = [intrinsic.laplace_beltrami(*_two_triangulations(n_inner, k)) for k in (0, 1)]
+    cells = intrinsic.delaunay_tessellation(intrinsic.from_mesh(V, triangulations[0]))
+    differ = np.any(np.sort(triangulations[0], 1) != np.sort(triangulations[1], 1))
+    if not differ or abs(cube[0] - cube[1]).max() > 1e-14 or cells.n_cells != 6 or np.any(cells.cell_size != 2):
+        return float("inf")
     return max(abs(a - b).max() / abs(a).max() for a, b in (cube, disk))
 
 
@@ -271,47 +369,62 @@ def laplace_beltrami_isometry_invariant(ctx):
     ring = np.unique(F[np.any(F == 0, axis=1)])
     ring = ring[ring != 0]
     centre = V[ring].mean(axis=0)
-    normal = np.linalg.svd(V[ring] - centre)[2][-1]  # the five neighbours are coplanar
+    normal = np.linalg.svd(V[ring] - centre)[2][-1]
     pushed = V.copy()
     pushed[0] = V[0] - 2 * np.dot(V[0] - centre, normal) * normal
     L, L_pushed = intrinsic.laplace_beltrami(V, F), intrinsic.laplace_beltrami(pushed, F)
-    return float(abs(L - L_pushed).max() / abs(L).max()) if np.linalg.norm(pushed[0] - V[0]) > 0.1 else float("inf")
+    coplanar = np.abs((V[ring] - centre) @ normal).max() < 1e-12  # the reflection is an isometry of the star
+    moved = np.linalg.norm(pushed[0] - V[0]) > 0.1
+    return float(abs(L - L_pushed).max() / abs(L).max()) if coplanar and moved else float("inf")
 
 
 _fig_7_26 = functools.cache(figures.fig_7_26)
-FIG_7_26 = dict(quick=dict(seed=0, budget=30), full=dict(seed=1, budget=200))  # the sizes of the Fig 7.26 checks
+# the sizes of the Fig 7.26 checks: the tall domes of these seeds, `budget` iterations each
+FIG_7_26 = dict(quick=dict(seeds=(0, 1, 2), budget=30), full=dict(seeds=(0, 1, 2, 3), budget=200))
 
 
 @check("Fig 7.26", "negative control: the cotan iteration (Fig 6.5) from the skinny tall dome does not converge",
-       quantity="area-gradient residual when the budget ran out or an iterate degenerated", at_least=1e-6, **FIG_7_26)
-def cotan_iteration_stuck(ctx, seed, budget):
-    *_, cotan, _ = _fig_7_26(seed, budget)
-    return float(cotan[2]["residual"]) if not cotan[2]["converged"] else 0.0
+       quantity="min over the domes of the area-gradient residual when the budget ran out or an iterate degenerated",
+       at_least=1e-6, **FIG_7_26)
+def cotan_iteration_stuck(ctx, seeds, budget):
+    cotans = [_fig_7_26(seed, budget)[3][2] for seed in seeds]
+    return min(float(info["residual"]) if not info["converged"] else 0.0 for info in cotans)
 
 
-@check("Def 7.9, Fig 7.23, 7.26", "from the same start Fig 7.23 (flips + Laplace–Beltrami) converges to a minimal surface "
-       "in the narrow sense: Delaunay, Δf = 0, the flat 32-gon",
-       quantity="max |Δf| at free vertices + |A − A(32-gon)| / A", at_most=1e-9, **FIG_7_26)
-def narrow_minimal_surface_converges(ctx, seed, budget):
-    V, F, boundary, cotan, (W, F1, info) = _fig_7_26(seed, budget)
-    tri = info["triangulation"]
-    fixed = np.zeros(len(W), dtype=bool)
-    fixed[boundary] = True
-    residual = interior_residual(intrinsic.cotan_laplacian(tri), W, fixed)
-    figures.draw_fig_7_26(ctx.figure("fig_7_26.png"), V, F, cotan, (W, F1, info))
-    polygon = 0.5 * 32 * np.sin(2 * np.pi / 32)
-    ok = info["converged"] and intrinsic.is_delaunay(tri) and info["flips"].sum() > 0
-    return residual + abs(info["area"][-1] - polygon) / polygon if ok else float("inf")
+@check("Def 7.9, Fig 7.23, 7.26", "from the same start Fig 7.23 (flips + Laplace–Beltrami) converges within 5 steps to a "
+       "minimal surface in the narrow sense: Delaunay, Δf = 0, the boundary kept, the flat 32-gon",
+       quantity="max over the domes of max |Δf| at free vertices + |A − A(32-gon)| / A", at_most=1e-9, **FIG_7_26)
+def narrow_minimal_surface_converges(ctx, seeds, budget):
+    worst = 0.0
+    for seed in seeds:
+        V, F, boundary, cotan, (W, F1, info) = _fig_7_26(seed, budget)
+        tri = info["triangulation"]
+        fixed = np.zeros(len(W), dtype=bool)
+        fixed[boundary] = True
+        residual = interior_residual(intrinsic.cotan_laplacian(tri), W, fixed)
+        if seed == seeds[0]:
+            figures.draw_fig_7_26(ctx.figure("fig_7_26.png"), V, F, cotan, (W, F1, info))
+        polygon = 0.5 * 32 * np.sin(2 * np.pi / 32)
+        ok = (info["converged"] and info["iterations"] <= 5 and intrinsic.is_delaunay(tri) and info["flips"].sum() > 0
+              and np.array_equal(W[boundary], V[boundary]))
+        worst = max(worst, residual + abs(info["area"][-1] - polygon) / polygon if ok else float("inf"))
+    return worst
 
 
 @check("Remark 7.10, Prop 6.8", "maximum principle: every free vertex of the narrow-sense minimal surface is the "
        "weighted mean of its Delaunay neighbours with weights ≥ 0",
-       quantity="max |f(i) − Σ ν_ij f(j) / Σ ν_ij| + max(0, −min ν)", at_most=1e-9, **FIG_7_26)
-def narrow_minimal_surface_maximum_principle(ctx, seed, budget):
-    _, _, boundary, _, (W, _, info) = _fig_7_26(seed, budget)
-    L = intrinsic.cotan_laplacian(info["triangulation"]).tocsr()
-    D = L.diagonal()
-    off = (L - sp.diags(D)).tocsr()
-    free = np.setdiff1d(np.arange(len(W)), boundary)
-    mean = -(off @ W)[free] / D[free][:, None]
-    return float(np.max(np.abs(W[free] - mean))) + max(0.0, float(off.max()))
+       quantity="max over the domes of max |f(i) − Σ ν_ij f(j) / Σ ν_ij| (∞ unless every ν_ij ≥ −1e-12)", at_most=1e-9,
+       **FIG_7_26)
+def narrow_minimal_surface_maximum_principle(ctx, seeds, budget):
+    worst = 0.0
+    for seed in seeds:
+        _, _, boundary, _, (W, _, info) = _fig_7_26(seed, budget)
+        L = intrinsic.cotan_laplacian(info["triangulation"]).tocsr()
+        D = L.diagonal()
+        off = (L - sp.diags(D)).tocsr()
+        if off.max() > 1e-12:  # a negative weight ν_ij = −L_ij
+            return float("inf")
+        free = np.setdiff1d(np.arange(len(W)), boundary)
+        mean = -(off @ W)[free] / D[free][:, None]
+        worst = max(worst, float(np.max(np.abs(W[free] - mean))))
+    return worst
