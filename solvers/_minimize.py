@@ -3,7 +3,7 @@
 `solve` finds critical points of every index (Euler's figure-eight elastica is a saddle), so it
 may also settle on a saddle when a minimum is wanted.  For the unconstrained problem
 `min E(u)` (fixed entries allowed) each step here factorises the shifted Hessian `H + δI` by a
-factorisation that reports its inertia (`SparseDirect`'s `LDLᵀ`, Sylvester's law; the
+factorisation that reports its inertia (`SparseDirect`'s `LDLᵀ` by Pardiso or CHOLMOD, Sylvester's law; the
 eigenvalues for a dense Hessian) and raises δ until the matrix is positive definite, as
 interior-point codes do (Wächter & Biegler 2006, Sec 3.1):
 
@@ -13,8 +13,8 @@ with δ_min = 1e-8 max|H|.  The step `d = −(H + δI)⁻¹ ∇E` is then a desc
 backtracking line search takes the largest α in {1, ½, …} with Armijo's decrease
 `E(u + αd) ≤ E(u) + 10⁻⁴ α ∇E·d` (at the round-off level of E, a decrease of |∇E| instead).
 Near a nondegenerate minimum δ = 0 and α = 1: Newton's quadratic convergence.  The run ends
-when the scaled gradient is below `tol` *and* the unshifted Hessian there has no negative
-eigenvalue; a point with a small gradient and a negative eigenvalue is a saddle and is left
+when the scaled gradient is below `tol` *and* the Hessian there has no eigenvalue below
+−10⁻¹⁰ max|H| (the second-order condition, flat directions of a symmetry allowed); a point with a small gradient and a negative eigenvalue is a saddle and is left
 along the corrected direction.
 
 The result is handed to `solve` from the minimum (zero Newton steps), so it is a `Solution`
@@ -33,7 +33,7 @@ from ddgjax.errors import ConvergenceError, InvalidInputError
 from ddgjax.problem import Problem
 
 from ._dense import DenseLU
-from ._direct import SparseDirect, cholmod_available
+from ._direct import SparseDirect, default_factoriser
 from ._kkt import KKT, residual_weights, scaled_residual, spec_of
 from ._solve import Solution, linear_solver_of, solve
 
@@ -41,6 +41,7 @@ ARMIJO = 1e-4
 DELTA_MIN, DELTA_GROWTH, DELTA_DECAY, DELTA_MAX = 1e-8, 8.0, 3.0, 1e20
 MAX_BACKTRACK = 40
 ROUNDOFF = 1e-14
+FLAT = 1e-10  # eigenvalues of H above −FLAT·max|H| count as zero (symmetries, flat directions)
 
 
 @partial(jax.jit, static_argnames=("spec",))
@@ -100,7 +101,7 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
     converge to a saddle.
 
     **Arguments:** `tol` on the scaled max-norm gradient (as `solve`); `max_steps` Newton steps;
-    `linear_solver` `SparseDirect()` (default for a problem declared local, with CHOLMOD) or
+    `linear_solver` `SparseDirect()` (default for a problem declared local, with Pardiso or CHOLMOD) or
     `DenseLU()` (otherwise; inertia from the eigenvalues, for small problems); `throw` raise
     `ConvergenceError` when not converged.
 
@@ -117,10 +118,10 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
             "problems use solve and check the index of the solution"
         )
     if linear_solver is None:
-        linear_solver = SparseDirect() if spec.is_local and cholmod_available() else DenseLU()
-    if isinstance(linear_solver, SparseDirect) and linear_solver.factoriser != "cholmod":
-        raise InvalidInputError("minimize needs the inertia of CHOLMOD's LDLᵀ: SparseDirect(factoriser='cholmod') "
-                                "(pip install scikit-sparse) or DenseLU()")
+        linear_solver = SparseDirect() if spec.is_local and default_factoriser() else DenseLU()
+    if isinstance(linear_solver, SparseDirect) and linear_solver.factoriser == "superlu":
+        raise InvalidInputError("minimize needs the inertia of an LDLᵀ: SparseDirect() with Pardiso (pip install "
+                                "pypardiso) or CHOLMOD, or DenseLU()")
     if not isinstance(linear_solver, (SparseDirect, DenseLU)):
         raise InvalidInputError(f"minimize needs the inertia of the Hessian: SparseDirect() or DenseLU(), got {linear_solver!r}")
     linear = linear_solver_of(problem, spec, "auto", linear_solver)
@@ -134,7 +135,8 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
     for step in range(max_steps + 1):
         K = _hessian(spec, linear, z0, params, u)
         if history[-1] <= tol:
-            if _convexified(linear, K, 0.0)[1] <= 0:  # a minimum (or inertia unknown at a PD-shifted solve)
+            # second-order condition: no eigenvalue of H below −ε max|H| (flat directions pass)
+            if _convexified(linear, K, FLAT * _scale(linear, K))[1] == 0:
                 status = "converged"
                 break
         if step == max_steps:

@@ -18,7 +18,7 @@ from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
 from ._banded import chain_structure
 from ._cache import derived
 from ._dense import DenseLU
-from ._direct import SparseDirect, cholmod_available
+from ._direct import SparseDirect, default_factoriser
 from ._klu import KLU
 from ._krylov import Krylov
 from ._linear import LinearSolver
@@ -82,9 +82,9 @@ def is_chain(problem: Problem, spec: Spec) -> bool:
 
 def sparse_direct_for(problem: Problem, spec: Spec) -> LinearSolver:
     """`method="sparse"`: KLU for chains (banded, no fill: KLU is fastest there), the
-    fill-reducing `SparseDirect` with CHOLMOD otherwise (meshes; KLU where scikit-sparse is
-    not installed: SuperLU, the other factoriser, is slower than KLU there)."""
-    if is_chain(problem, spec) or not cholmod_available():
+    fill-reducing `SparseDirect` with Pardiso (or CHOLMOD) otherwise (meshes; KLU where neither
+    is installed: SuperLU, the remaining factoriser, is slower than KLU there)."""
+    if is_chain(problem, spec) or default_factoriser() is None:
         return KLU()
     return SparseDirect()
 

@@ -11,13 +11,16 @@ import ddgjax as dg
 from ddgjax.errors import InvalidInputError
 from energies import area, elastica
 from solvers import KLU, DenseLU, Krylov, LinearSolver, SparseDirect, solve, solve_batch
-from solvers._direct import cholmod_available
+from solvers._direct import cholmod_available, default_factoriser, pardiso_available
 from solvers._kkt import KKT, spec_of
 
-needs_cholmod = pytest.mark.skipif(not cholmod_available(), reason="scikit-sparse (CHOLMOD) not installed")
+needs_ldl = pytest.mark.skipif(default_factoriser() is None, reason="neither MKL Pardiso nor CHOLMOD installed")
+LDL = [f for f, ok in (("pardiso", pardiso_available()), ("cholmod", cholmod_available())) if ok]
 
 CLAMPED = dict(chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
 BACK_ENDS = [DenseLU(), KLU(), SparseDirect(), SparseDirect(factoriser="superlu"), Krylov()]
+if cholmod_available():
+    BACK_ENDS.append(SparseDirect(factoriser="cholmod"))
 
 
 def _saddle(k: int = 8):
@@ -49,7 +52,8 @@ def test_every_back_end_finds_the_same_elastica(reference, linear):
     assert np.max(np.abs(np.asarray(sol.multipliers["chord"]) - np.asarray(ref.multipliers["chord"]))) <= 1e-8
 
 
-@pytest.mark.parametrize("linear", [SparseDirect(), SparseDirect(factoriser="superlu"), KLU()], ids=repr)
+@pytest.mark.parametrize("linear", [SparseDirect(), SparseDirect(factoriser="superlu"), KLU()]
+                         + ([SparseDirect(factoriser="cholmod")] if cholmod_available() else []), ids=repr)
 def test_sparse_back_ends_agree_on_a_minimal_surface(linear):
     V, F, boundary = _saddle()
     problem = area.simplicial(V, F, boundary)
@@ -59,7 +63,7 @@ def test_sparse_back_ends_agree_on_a_minimal_surface(linear):
     assert np.max(np.abs(np.asarray(sol.x) - np.asarray(ref.x))) <= 1e-10
 
 
-@needs_cholmod
+@needs_ldl
 def test_method_sparse_takes_klu_on_chains_and_sparse_direct_on_meshes():
     from solvers._solve import linear_solver_of
 
@@ -89,14 +93,15 @@ def test_gradient_and_batch_through_sparse_direct(reference):
         assert np.max(np.abs(np.asarray(batch.x[k]) - np.asarray(one.x))) <= 1e-12
 
 
-@needs_cholmod
-def test_ldl_inertia_counts_negative_eigenvalues():
+@needs_ldl
+@pytest.mark.parametrize("factoriser", LDL)
+def test_ldl_inertia_counts_negative_eigenvalues(factoriser):
     """Sylvester's law: the negative pivots of `LDLᵀ` count the negative eigenvalues, here of the
     area Hessian shifted between its 3rd and 4th eigenvalue (three negative ones)."""
     V, F, boundary = _saddle()
     problem = area.simplicial(V, F, boundary)
     spec = spec_of(problem)
-    linear = SparseDirect().bind(problem, spec)
+    linear = SparseDirect(factoriser=factoriser).bind(problem, spec)
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
     K = linear.matrix(kkt, spec.layout.ravel(problem.x0)[spec.layout.free])
     dense = np.zeros((spec.n, spec.n))
