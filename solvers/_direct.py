@@ -11,10 +11,13 @@ the device exactly as for `KLU` (`AssembledSparse`), then
   factorisation it keeps;
 - `apply(token, b)` solves with that factorisation (Newton's damping test reuses it).
 
-The host keeps, per thread, the factorisations of the latest `factor_matrix` call only: a
-Newton step's factorisation is dead once the next one is made, because the next step depends
-on the results of the current step's solves.  `jax.vmap` calls each callback once with the whole
-batch (`vmap_method="broadcast_all"`), which factorises every member and keeps them all.
+The host keeps the two latest factorisations per batch member (`LIVE_PER_MEMBER`) and frees
+older ones: a Newton step's factorisation is dead once the next one is made, because the next
+step depends on the results of the current step's solves (the second one kept lets two solves of
+one pattern alternate; more concurrent solves of one pattern raise an error naming the freed
+factorisation).  XLA may run the callbacks on any of its threads, so nothing is kept per thread.
+`jax.vmap` calls each callback once with the whole batch (`vmap_method="broadcast_all"`), which
+factorises every member and keeps them all.
 `jax.grad` works as on every back end (the adjoint is one more factorisation and solve, `K`
 being symmetric).  Tracing, transformations and device placement are those of a host callback:
 CPU and GPU runs both work, a GPU run copies the values to the host and back each step.
@@ -41,6 +44,7 @@ from __future__ import annotations
 import functools
 import threading
 import weakref
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import jax
@@ -114,25 +118,29 @@ class Factorisation:
 
     solve: object
     negative: int = -1
+    handle: object = None  # the Pardiso handle holding the factors, returned to the pool when dead
 
 
+LIVE_PER_MEMBER = 2  # factorisations kept per batch member: the current one and one more (another stream)
 PIVOT_FLOOR = 1e-14  # an LDLᵀ pivot below this, relative to the largest, falls back to LU with pivoting
 
 
 @dataclass(eq=False)
 class HostFactors:
     """The host side of one pattern: its CSC structure, its symbolic analysis, and the live
-    numeric factorisations by token (the latest `factor` call's, per thread)."""
+    numeric factorisations by token (the latest ones, `LIVE_PER_MEMBER` per member).  Pardiso keeps
+    its analysis and factors in handles: a pool of them, each analysed once, taken by a
+    factorisation and returned when it dies (usually one handle per pattern)."""
 
     pattern: SparsePattern
     factoriser: str
     indptr: np.ndarray = field(init=False)
     indices: np.ndarray = field(init=False)
     _symbolic: object = field(init=False, default=None)
-    _live: dict = field(init=False, default_factory=dict)
+    _live: OrderedDict = field(init=False, default_factory=OrderedDict)
+    _handles: list = field(init=False, default_factory=list)  # free Pardiso handles, analysed
     _next: int = field(init=False, default=0)
     _lock: threading.Lock = field(init=False, default_factory=threading.Lock)
-    _mine: threading.local = field(init=False, default_factory=threading.local)
 
     def __post_init__(self):
         self.indptr, self.indices = _csc_structure(self.pattern)
@@ -175,21 +183,16 @@ class HostFactors:
 
         return Factorisation(spla.splu(A, permc_spec="COLAMD").solve)
 
-    def _pardiso_handle(self, slot: int):
-        """This thread's Pardiso handle number `slot` (a batch member), analysed for the pattern."""
+    def _new_pardiso_handle(self):
+        """A Pardiso handle with its analysis of the pattern made (phase 11), freed with it."""
         import pypardiso
 
-        handles = getattr(self._mine, "pardiso", None)
-        if handles is None:
-            handles = self._mine.pardiso = []
-        while len(handles) <= slot:
-            handle = pypardiso.PyPardisoSolver(mtype=-2)
-            handle.libmkl.MKL_Set_Num_Threads(PARDISO_THREADS)
-            handle.set_iparm(12, 0)  # CSR (of the upper triangle)
-            self._pardiso_call(handle, 11, np.zeros(self.upper.size), np.zeros(self.size))
-            weakref.finalize(handle, _release_pardiso, handle._mkl_pardiso, handle.pt, handle.iparm, handle._pt_type[0])
-            handles.append(handle)
-        return handles[slot]
+        handle = pypardiso.PyPardisoSolver(mtype=-2)
+        handle.libmkl.MKL_Set_Num_Threads(PARDISO_THREADS)
+        handle.set_iparm(12, 0)  # CSR (of the upper triangle)
+        self._pardiso_call(handle, 11, np.zeros(self.upper.size), np.zeros(self.size))
+        weakref.finalize(handle, _release_pardiso, handle._mkl_pardiso, handle.pt, handle.iparm, handle._pt_type[0])
+        return handle
 
     def _pardiso_call(self, handle, phase: int, values: np.ndarray, b: np.ndarray) -> np.ndarray:
         """One call of MKL's `pardiso` on the upper-triangle CSR with these values: phase 11
@@ -216,9 +219,8 @@ class HostFactors:
             raise PyPardisoError(error.value)
         return np.ascontiguousarray(x)
 
-    def _pardiso(self, values: np.ndarray, slot: int) -> Factorisation:
-        """Pardiso's `LDLᵀ` of the matrix with these (full CSR) values, in handle `slot`."""
-        handle = self._pardiso_handle(slot)
+    def _pardiso(self, values: np.ndarray, handle) -> Factorisation:
+        """Pardiso's `LDLᵀ` of the matrix with these (full CSR) values, kept in `handle`."""
         upper = np.ascontiguousarray(values[self.upper])
         self._pardiso_call(handle, 22, upper, np.zeros(self.size))
         negative = int(handle.iparm[22])  # iparm(23): the number of negative eigenvalues
@@ -226,13 +228,13 @@ class HostFactors:
         def solve(b):
             return self._pardiso_call(handle, 33, upper, b)
 
-        return Factorisation(solve, negative)
+        return Factorisation(solve, negative, handle)
 
-    def factorise(self, values: np.ndarray, slot: int = 0) -> Factorisation:
-        """A factorisation of the matrix with these CSC values (`slot`: the batch member, for
-        factorisers that keep their factors in a handle)."""
+    def factorise(self, values: np.ndarray, handle=None) -> Factorisation:
+        """A factorisation of the matrix with these CSC values (`handle`: where a factoriser
+        that keeps its factors in a handle, Pardiso, keeps them)."""
         if self.factoriser == "pardiso":
-            return self._pardiso(values, slot)
+            return self._pardiso(values, handle if handle is not None else self._new_pardiso_handle())
         A = self.matrix(values)
         if self.factoriser == "cholmod":
             fac = self._ldl(A)
@@ -246,14 +248,20 @@ class HostFactors:
         values = np.asarray(values)
         batch = values.shape[:-1]
         flat = values.reshape(-1, values.shape[-1])
-        made = [self.factorise(np.ascontiguousarray(v), slot) for slot, v in enumerate(flat)]
         with self._lock:
-            for token in getattr(self._mine, "tokens", ()):
-                self._live.pop(token, None)
+            # the oldest factorisations are dead (module docstring): free them, keeping at most
+            # `LIVE_PER_MEMBER` per batch member, their handles free for reuse
+            capacity = LIVE_PER_MEMBER * len(flat)
+            while self._live and len(self._live) + len(flat) > capacity:
+                dead = self._live.popitem(last=False)[1]
+                if dead.handle is not None:
+                    self._handles.append(dead.handle)
+            handles = [self._handles.pop() if self._handles else None for _ in range(len(flat))]
+        made = [self.factorise(np.ascontiguousarray(v), h) for v, h in zip(flat, handles)]
+        with self._lock:
             tokens = np.arange(self._next, self._next + len(made), dtype=np.int64)
             self._next += len(made)
             self._live.update(zip(tokens.tolist(), made))
-        self._mine.tokens = tokens.tolist()
         negative = np.array([fac.negative for fac in made], np.int64)
         return tokens.reshape(batch), negative.reshape(batch)
 
@@ -266,7 +274,10 @@ class HostFactors:
         flat_out = out.reshape(flat_b.shape)
         for i, token in enumerate(flat_t.tolist()):
             with self._lock:
-                fac = self._live[token]
+                fac = self._live.get(token)
+            if fac is None:
+                raise RuntimeError(f"SparseDirect: factorisation {token} was freed: more concurrent solves of one "
+                                   "pattern than it keeps (run them one after another)")
             flat_out[i] = fac.solve(np.ascontiguousarray(flat_b[i]))
         return out
 
