@@ -6,40 +6,43 @@ side by side with libigl's `intrinsic_delaunay_cotmatrix` and robust-laplacian's
 Meshes of about 10⁴, 10⁵, 10⁶ faces: a round icosphere (Delaunay already, no flips), a strongly
 stretched ellipsoid (the icosphere scaled 20 : 1 : 1) and a sheared, squashed torus of thin
 triangles; the last two need about 1.5 flips per face.  ddgjax's flip loop is compiled by numba
-(cached on disk: a fresh machine compiles it once, about 2.5 s CPU); its cotan weights are one
+(cached on disk: a fresh machine compiles it once, about 4 s CPU); its cotan weights are one
 jit-compiled autodiff kernel, compiled for a few shape buckets (the first call is a warm-up and
 not counted).  Calls are interleaved and both wall and CPU time (`time.process_time`, all three
 run on one core) are reported: on a shared machine the CPU time is the fairer measure.  The flip
 phase is also timed alone (`flip_to_delaunay` on a prebuilt triangulation, no history: the
-derived cotangents of the start and of the result, and the flip loop) and divided by the flip
-count.
+flip loop with the keys of its start, and the derived cotangents of the result) and divided
+by the flip count.
 
     python benchmarks/intrinsic.py [--quick | --large] [--repeats 3] [--repeats-large 2] [--rl-repeats-large 0]
 
 Measured 2026-12-01 on the shared 2-core development machine (other jobs running, load about
-3–4: noisy; CPU times are the comparison), libigl and robust-laplacian from pip, medians of 3 (2
-above 5·10⁵ faces; robust-laplacian once there):
+2–4: noisy; CPU times are the comparison), libigl and robust-laplacian from pip, medians of 3 (2
+above 5·10⁵ faces; robust-laplacian once there; the flip phase one call):
 
 | mesh | faces | flips | rounds | flip phase CPU (ns/flip) | ddgjax CPU (s) | libigl CPU (s) | robust-laplacian CPU (s) | igl / ddgjax | rl / ddgjax | ddgjax wall (s) | libigl wall (s) | robust-laplacian wall (s) | max rel diff vs igl |
 |---|---|---|---|---|---|---|---|---|---|---|---|---|---|
-| sphere | 20480 | 0 | 0 | – | 0.008 | 0.013 | 0.041 | 1.57 | 4.96 | 0.012 | 0.016 | 0.084 | 4.9e-16 |
-| sphere | 81920 | 0 | 0 | – | 0.028 | 0.060 | 0.237 | 2.12 | 8.33 | 0.043 | 0.092 | 0.346 | 4.9e-16 |
-| sphere | 1310720 | 0 | 0 | – | 0.876 | 1.638 | 8.633 | 1.87 | 9.85 | 1.307 | 2.432 | 12.368 | 6.1e-16 |
-| ellipsoid 20:1:1 | 20480 | 31052 | 18 | 200 | 0.014 | 0.019 | 0.098 | 1.41 | 7.23 | 0.017 | 0.026 | 0.139 | 3.9e-13 |
-| ellipsoid 20:1:1 | 81920 | 126239 | 19 | 197 | 0.047 | 0.107 | 0.622 | 2.26 | 13.09 | 0.068 | 0.167 | 0.921 | 2.5e-12 |
-| ellipsoid 20:1:1 | 1310720 | 2025068 | 17 | 254 | 1.163 | 2.853 | 21.014 | 2.45 | 18.07 | 1.817 | 4.214 | 31.325 | 2.5e-12 |
-| sheared torus | 10000 | 15351 | 13 | 217 | 0.006 | 0.009 | 0.024 | 1.59 | 4.31 | 0.010 | 0.021 | 0.034 | 1.5e-13 |
-| sheared torus | 102400 | 158208 | 10 | 173 | 0.046 | 0.072 | 0.336 | 1.56 | 7.24 | 0.074 | 0.116 | 0.521 | 3.6e-15 |
-| sheared torus | 1310720 | 2552580 | 12 | 182 | 0.884 | 1.393 | 6.782 | 1.58 | 7.67 | 1.337 | 2.070 | 10.018 | 3.2e-15 |
+| sphere | 20480 | 0 | 0 | – | 0.010 | 0.017 | 0.058 | 1.64 | 5.65 | 0.010 | 0.018 | 0.058 | 6.1e-16 |
+| sphere | 81920 | 0 | 0 | – | 0.034 | 0.084 | 0.373 | 2.43 | 10.82 | 0.035 | 0.084 | 0.377 | 4.9e-16 |
+| sphere | 1310720 | 0 | 0 | – | 0.739 | 1.745 | 11.122 | 2.36 | 15.05 | 0.798 | 1.793 | 11.379 | 6.1e-16 |
+| ellipsoid 20:1:1 | 20480 | 31052 | 18 | 157 | 0.011 | 0.021 | 0.116 | 1.84 | 10.26 | 0.011 | 0.023 | 0.116 | 3.9e-13 |
+| ellipsoid 20:1:1 | 81920 | 126239 | 19 | 118 | 0.054 | 0.154 | 0.793 | 2.83 | 14.60 | 0.054 | 0.157 | 0.804 | 2.5e-12 |
+| ellipsoid 20:1:1 | 1310720 | 2025068 | 17 | 124 | 1.047 | 3.510 | 19.704 | 3.35 | 18.83 | 1.047 | 3.467 | 19.730 | 2.5e-12 |
+| sheared torus | 10000 | 15351 | 13 | 146 | 0.005 | 0.009 | 0.024 | 1.64 | 4.34 | 0.005 | 0.009 | 0.024 | 1.5e-13 |
+| sheared torus | 102400 | 158208 | 10 | 121 | 0.031 | 0.066 | 0.251 | 2.13 | 8.14 | 0.031 | 0.066 | 0.251 | 3.6e-15 |
+| sheared torus | 1310720 | 2552580 | 12 | 84 | 0.484 | 1.238 | 6.849 | 2.56 | 14.14 | 0.500 | 1.274 | 6.913 | 3.2e-15 |
 
-Reading: at 1.3·10⁶ faces ddgjax is 1.6× faster than libigl on the sheared torus, 2.5× on the
-stretched ellipsoid and 1.9× on the sphere, and 8–18× faster than robust-laplacian.  The flip
-phase costs 180–250 ns per flip at 1.3·10⁶ faces (a second `--large` run the same day: 185 and
-247); the vectorised numpy rounds it replaced cost 488 (ellipsoid) and 321 (torus) ns per flip
-in a `--large` run the same day.  Of the flip phase, the compiled loop itself takes 95–150 ns
-per flip (timed alone on the same machine), the two derived-cotangent kernels (the autodiff
-Hessian of the Dirichlet energy, of the start and of the result) about 0.15–0.2 s together,
-i.e. 60–100 ns per flip on these meshes.
+Reading: at 1.3·10⁶ faces ddgjax is 2.4× faster than libigl on the sphere, 3.4× on the
+stretched ellipsoid and 2.6× on the sheared torus, and 14–19× faster than robust-laplacian.  The
+flip phase costs 124 (ellipsoid) and 84 (torus) ns per flip at 1.3·10⁶ faces; the code before
+(derived start keys and a non-inlined loop) cost 283 and 226 in a run of the same hour (igl /
+ddgjax 2.29, 2.24, 1.52).  In three `--large` runs at a higher load the same day the flip phase
+took 166–183 and 107–120 ns per flip and igl / ddgjax was 2.5–2.7, 3.1–3.3 and 2.2–2.5: the
+single call on a freshly built triangulation also pays for first-touch page faults (30–40 ns per
+flip more than a repeated call).  Of the flip phase, the compiled loop with its start keys
+takes about 100–130 (ellipsoid) and 70–90 (torus) ns per flip, memory-bound on the ellipsoid
+(65–80 ns per flip on meshes that fit in cache), and the derived cotangents of the result
+(gather, one autodiff kernel on all faces, interleave) about 25–45 ms.
 "rounds" is the longest cascade of flips (`FlipResult.n_rounds`).  Time grows about linearly;
 meshes whose vertex labels are not spatially coherent are renumbered along a Morton curve first
 (`ddgjax.intrinsic.ordering`), for cache locality.  Results do not depend on the flip order

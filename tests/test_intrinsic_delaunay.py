@@ -83,9 +83,8 @@ def test_gluing_stays_consistent_through_many_batched_flips():
 
 
 def test_cached_cotangents_of_the_result_equal_a_fresh_computation():
-    """The flip loop keeps only the keys cot + tol · s and recovers the cotangents of the result
-    from them (the cotangents of a face sum to s, Lemma 7.17): they agree with the law of
-    cosines on the final lengths to rounding, and so does h(T)."""
+    """The cotangents of the result (derived: the autodiff Hessian of the Dirichlet energy)
+    agree with the law of cosines on the final lengths to rounding, and so does h(T)."""
     V, F = icosphere(3)
     tri = T.from_mesh(V * np.array([12.0, 1.0, 0.5]), F)
     result = dg.intrinsic.flip_to_delaunay(tri)
@@ -96,6 +95,45 @@ def test_cached_cotangents_of_the_result_equal_a_fresh_computation():
     assert np.max(np.abs(result.halfedge_cotangents - per_side) / scale) < 1e-13
     unrecorded = dg.intrinsic.flip_to_delaunay(tri, record_history=False)
     np.testing.assert_allclose(unrecorded.harmonic_index[-1], dg.intrinsic.harmonic_index(result), rtol=1e-13)
+
+
+def test_start_keys_are_the_derived_cotangents_to_rounding():
+    """The loop's keys of the start (law of cosines, `corner_cotangents`) agree with the derived
+    cotangents (autodiff) to rounding, and the angle test fails on the same edges with either."""
+    from ddgjax.intrinsic.delaunay import DELAUNAY_TOL, _face_geometry
+    from ddgjax.intrinsic.flip_algorithm import start_keys
+
+    V, F = icosphere(3)
+    tri = T.from_mesh(V * np.array([12.0, 1.0, 0.5]), F)
+    cot, s = _face_geometry(tri)
+    derived = np.append(cot + DELAUNAY_TOL * np.repeat(s, 3), np.inf)
+    key, _, h = start_keys(tri.edge, tri.lengths, DELAUNAY_TOL)
+    assert np.max(np.abs(key[:-1] - derived[:-1]) / np.repeat(s, 3)) < 1e-14
+    he = tri.halfedges
+    fails = key[he[:, 0]] + key[he[:, 1]] < 0
+    assert 100 < fails.sum() and np.array_equal(fails, derived[he[:, 0]] + derived[he[:, 1]] < 0)
+    np.testing.assert_allclose(h, dg.intrinsic.harmonic_index(tri), rtol=1e-14)
+
+
+def test_a_recorded_run_flips_as_an_unrecorded_one():
+    """A recorded run keeps the history in a buffer and resumes the loop from its state when the
+    buffer is full (`flip_algorithm.sweep`): with several refills it makes the same flips as a
+    run without history, and its history ends at the same h(T)."""
+    V, F = icosphere(4)
+    tri = T.from_mesh(V * np.array([15.0, 1.0, 0.3]), F)
+    recorded = dg.intrinsic.flip_to_delaunay(tri)
+    unrecorded = dg.intrinsic.flip_to_delaunay(tri, record_history=False)
+    assert recorded.n_flips == unrecorded.n_flips > 4 * 1024
+    assert recorded.n_rounds == unrecorded.n_rounds
+    for a, b in zip((recorded.F, recorded.triangulation.edge, recorded.triangulation.halfedges, recorded.lengths),
+                    (unrecorded.F, unrecorded.triangulation.edge, unrecorded.triangulation.halfedges,
+                     unrecorded.lengths)):
+        np.testing.assert_array_equal(a, b)
+    assert recorded.harmonic_index_steps.shape == (recorded.n_flips,)
+    assert np.all(recorded.harmonic_index_steps < 0)
+    assert recorded.harmonic_index[0] == unrecorded.harmonic_index[0]
+    np.testing.assert_allclose(recorded.harmonic_index[-1], unrecorded.harmonic_index[-1], rtol=1e-11)
+    np.testing.assert_array_equal(recorded.halfedge_cotangents, unrecorded.halfedge_cotangents)
 
 
 def test_flipping_in_place_equals_flipping_a_copy():

@@ -91,6 +91,29 @@ def test_lemma_7_17_corner_cotangents_are_minus_twice_the_derived_stiffness():
     np.testing.assert_allclose(K.sum(axis=2), 0, atol=1e-12 * np.abs(K).max())  # constants in the kernel
 
 
+def test_side_cotangent_columns_are_the_derived_stiffness_by_side():
+    """The columnwise kernel (Hessian-vector products of the summed Dirichlet energies) gives
+    the cotangents of `stiffness` (a `vmap` of `jax.hessian`) per side, padded or not, and
+    `side_cotangents` the same per face with Heron's areas."""
+    rng = np.random.default_rng(3)
+    P = rng.normal(size=(500, 3, 3))
+    l2 = lengths.squared_side_lengths(P)  # opposite corner k; side i is opposite corner i + 2
+    s2 = l2[:, [2, 0, 1]]
+    K = np.asarray(lengths.stiffness(l2))
+    by_side = -2 * K[:, [0, 1, 2], [1, 2, 0]]  # cot(side i) = −2 K[i, i + 1]
+    scale = np.abs(by_side).max(axis=1, keepdims=True)
+    rows = np.stack(lengths.side_cotangent_columns(np.ascontiguousarray(s2.T)), axis=1)
+    assert rows.shape == (500, 3) and np.max(np.abs(rows - by_side) / scale) < 1e-13
+    width = lengths.padded_size(500)
+    padded = np.ones((3, width))
+    padded[:, :500] = s2.T
+    np.testing.assert_array_equal(np.stack(lengths.side_cotangent_columns(padded, 500), axis=1), rows)
+    cot, area = lengths.side_cotangents(s2)
+    np.testing.assert_array_equal(cot, rows)
+    l = np.sqrt(l2)
+    np.testing.assert_array_equal(area, lengths.triangle_area(l[:, 0], l[:, 1], l[:, 2]))
+
+
 def test_dirichlet_energy_on_lengths_equals_the_cotangent_form():
     """E(f) = ¼ Σ_k cot α_k (f_{k+1} − f_{k+2})² (Sec 6.3), the energy written without angles."""
     rng = np.random.default_rng(2)

@@ -12,10 +12,11 @@
   flipped depth-first (a stack), so that every non-Delaunay edge is on the stack or not yet
   swept.  Every flip is one step of Fig 7.13, recorded in the history.  The test keys
   cot + tol · s of all corners and the areas of all faces are cached and updated at each flip,
-  so a test is two lookups.  The keys of the start and the cotan weights of the result are the
-  derived ones (`triangulation.halfedge_cotangents`: the autodiff Hessian of the Dirichlet
-  energy); the keys of the triangles a flip creates come from the law of cosines
-  (`ddgjax.mesh.lengths.corner_cotangents`).
+  so a test is two lookups.  The keys come from the law of cosines
+  (`ddgjax.mesh.lengths.corner_cotangents`, Lemma 7.17), those of the start as those of the
+  triangles a flip creates; the cotan weights of the result are the derived ones (the autodiff
+  Hessian of the Dirichlet energy, `ddgjax.mesh.lengths.side_cotangent_columns`, one compiled
+  call on all faces after the loop).
 
 Surfaces with boundary (which the reference does not treat) keep their boundary edges; only
 interior edges are tested and flipped, as in libigl's `intrinsic_delaunay_triangulation`.
@@ -34,12 +35,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FlipBudgetError, InvalidInputError
-from ..mesh.lengths import face_harmonic_index, side_cotangents, triangle_area
+from ..mesh.lengths import (
+    face_harmonic_index,
+    padded_size,
+    side_cotangent_columns,
+    side_cotangents,
+    triangle_area,
+)
 from .triangulation import (
     Triangulation,
     cotan_weights,
     from_faces,
-    halfedge_cotangents,
     of_arrays,
     side_lengths,
 )
@@ -79,12 +85,12 @@ def _interior(tri: Triangulation) -> np.ndarray:
 
 
 def _face_geometry(tri: Triangulation):
-    """(cot, area, s): per halfedge the cot of the angle opposite it (3 nf,), derived from the
-    Dirichlet energy (`triangulation.halfedge_cotangents`); per face its area and
+    """(cot, s): per halfedge the cot of the angle opposite it (3 nf,), derived from the
+    Dirichlet energy (`ddgjax.mesh.lengths.side_cotangents`); per face
     s = cot α + cot β + cot γ = (a² + b² + c²)/4A = h(Δ)/4 (nf,) (Lemma 7.17)."""
     L = side_lengths(tri)
-    cots, area = side_cotangents(L * L)
-    return cots.reshape(-1), np.array(area), cots.sum(axis=1)  # the area is updated by the flips
+    cots = side_cotangents(L * L)[0]
+    return cots.reshape(-1), cots.sum(axis=1)
 
 
 def edge_cotangent_sums(tri: Triangulation) -> np.ndarray:
@@ -96,7 +102,7 @@ def edge_cotangent_sums(tri: Triangulation) -> np.ndarray:
 def _non_delaunay(tri: Triangulation, tol: float) -> np.ndarray:
     """(ne,) bool: the interior edges between two distinct triangles that fail the angle test
     (one vectorised pass over the faces)."""
-    cots, _, scales = _face_geometry(tri)
+    cots, scales = _face_geometry(tri)
     scale = np.bincount(tri.edge, np.repeat(scales, 3), minlength=tri.n_edges)
     bad = np.bincount(tri.edge, cots, minlength=tri.n_edges) < -tol * scale
     out = np.zeros(tri.n_edges, dtype=bool)
@@ -166,16 +172,6 @@ class FlipResult:
         return self.triangulation.edges
 
 
-def _test_keys(cots, scales, tol: float) -> np.ndarray:
-    """(3 nf + 1,) per halfedge the test key cot + tol · s(face) of the angle opposite it, and
-    one more entry, +inf, read by the boundary's halfedge -1 (so that boundary edges always
-    pass): the test of an edge is key(h) + key(t) < 0 (Prop 7.9 with the tie tolerance)."""
-    key = np.empty(cots.size + 1)
-    np.add(cots.reshape(-1, 3), tol * scales[:, None], out=key[:-1].reshape(-1, 3))
-    key[-1] = np.inf
-    return key
-
-
 def flip_to_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL, max_flips: int | None = None,
                      record_history: bool = True) -> FlipResult:
     """Make a geodesic triangulation Delaunay by edge flips (Fig 7.13, Thm 7.12).
@@ -197,27 +193,24 @@ def flip_owned(tri: Triangulation, tol: float = DELAUNAY_TOL, max_flips: int | N
     """`flip_to_delaunay` of a triangulation whose arrays the caller owns: with `copy=False` they
     are flipped in place (and `tri` must not be used afterwards)."""
     # numba is loaded here, not at `import ddgjax`; the loop is compiled once per machine
-    from .flip_algorithm import flip_algorithm
+    from .flip_algorithm import flip_algorithm, interleaved, squared_sides
 
     budget = 50 * tri.n_faces + 1000 if max_flips is None else int(max_flips)
-    cots, area, scales = _face_geometry(tri)
     arrays = tuple(np.ascontiguousarray(a) for a in (tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths))
     if copy:
         arrays = tuple(a.copy() for a in arrays)
-    n_flips, n_rounds, steps, stuck = flip_algorithm(*arrays, _test_keys(cots, scales, tol), area, float(tol),
-                                                     budget, bool(record_history))
+    n_flips, n_rounds, steps, stuck, h0, key = flip_algorithm(*arrays, float(tol), budget, bool(record_history))
     if stuck >= 0:
         raise FlipBudgetError(
             f"flip budget of {budget} flips used up; edge {stuck} is still not Delaunay (raise "
             "max_flips, or check the lengths for near-degenerate triangles)"
         )
-    h0 = 4.0 * float(scales.sum())
-    out = tri
-    if n_flips:  # the derived cotangents of the new triangles (the keys hold the law of cosines)
-        out = of_arrays(*arrays, tri.n_vertices)
-        cots = halfedge_cotangents(out)
+    out = of_arrays(*arrays, tri.n_vertices) if n_flips else tri
+    # the derived cotangents of the result (the loop's keys hold the law of cosines)
+    by_side = side_cotangent_columns(squared_sides(arrays[1], arrays[3], padded_size(tri.n_faces)), tri.n_faces)
+    cots = interleaved(*by_side, key)  # into the buffer of the loop's keys
     if record_history:
         history = h0 + np.concatenate([[0.0], np.cumsum(steps)])
     else:
-        history = np.array([h0, 4.0 * float(cots.reshape(-1, 3).sum(axis=1).sum())])
+        history = np.array([h0, 4.0 * float(cots.sum())])
     return FlipResult(out, int(n_flips), int(n_rounds), history, steps, cots)

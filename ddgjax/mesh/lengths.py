@@ -38,6 +38,8 @@ __all__ = [
     "edge_lengths",
     "face_harmonic_index",
     "face_side_lengths",
+    "padded_size",
+    "side_cotangent_columns",
     "side_cotangents",
     "squared_side_lengths",
     "stiffness",
@@ -109,12 +111,14 @@ def dirichlet_energy(f: Float[Array, "3"], l2: Float[Array, "3"]) -> Float[Array
 
     A by Kahan's Heron (`triangle_area`).  It equals ¼ Σ_k cot α_k (f_{k+1} − f_{k+2})² (Thm 6.6),
     so its Hessian in f *derives* the cotan weights (`stiffness`).  `l2[k]` is the squared side
-    opposite corner k: l12² = l2[0], l02² = l2[1], l01² = l2[2].
+    opposite corner k: l12² = l2[0], l02² = l2[1], l01² = l2[2].  `f` and `l2` may also be
+    triples of equally shaped arrays (one triangle per entry, `side_cotangent_columns`).
     """
     g11, g22 = l2[2], l2[1]
     g12 = 0.5 * (l2[2] + l2[1] - l2[0])
     d1, d2 = f[1] - f[0], f[2] - f[0]
-    return (g22 * d1 * d1 - 2.0 * g12 * d1 * d2 + g11 * d2 * d2) / (8.0 * _area_from_squares(l2))
+    area = triangle_area(jnp.sqrt(l2[0]), jnp.sqrt(l2[1]), jnp.sqrt(l2[2]))
+    return (g22 * d1 * d1 - 2.0 * g12 * d1 * d2 + g11 * d2 * d2) / (8.0 * area)
 
 
 def _stiffness(l2):
@@ -149,8 +153,10 @@ def corner_weights(l2: Float[Array, "nf 3"]):
     return _off_diagonal(_stiffness(l2)), _sin2(l2)
 
 
-def _bucket(n: int) -> int:
-    """n rounded up to one of 8 sizes per octave (at most 12.5 % more, at least 64)."""
+def padded_size(n: int) -> int:
+    """The number of triangles the compiled kernels of this module run on for n: n rounded up
+    to one of 8 sizes per octave (at most 12.5 % more, at least 64), so that they compile for
+    few shapes (the extra ones are equilateral, all sides 1)."""
     if n <= 64:
         return 64
     step = 1 << (n.bit_length() - 4)
@@ -159,27 +165,77 @@ def _bucket(n: int) -> int:
 
 def _on_padded_rows(kernel, X):
     """`kernel(X)` for X (n, 3) with the rows padded by equilateral triangles (ones) up to
-    `_bucket(n)`, so that a jitted kernel compiles for few shapes; outputs cut back to n rows."""
+    `padded_size(n)`, so that a jitted kernel compiles for few shapes; outputs cut back to n rows."""
     X = np.asarray(X)
     n = X.shape[0]
-    if _bucket(n) > n:
-        X = np.concatenate([X, np.ones((_bucket(n) - n, 3), dtype=X.dtype)])
+    if padded_size(n) > n:
+        X = np.concatenate([X, np.ones((padded_size(n) - n, 3), dtype=X.dtype)])
     return jax.tree_util.tree_map(lambda a: np.asarray(a)[:n], kernel(X))
 
 
+def _on_padded_columns(kernel, X, n: int | None = None):
+    """`kernel(X)` for X (3, m) holding n ≤ m triangles (default m) in its first n columns, the
+    columns padded by equilateral triangles (ones) up to `padded_size(n)` unless X has those
+    already; outputs cut back to n columns (their last axis)."""
+    X = np.asarray(X)
+    n = X.shape[1] if n is None else n
+    width = padded_size(n)
+    if X.shape[1] != width:
+        X = np.concatenate([X[:, :n], np.ones((3, width - n), dtype=X.dtype)], axis=1)
+    if X.flags.c_contiguous and X.flags.writeable:
+        X = jnp.from_dlpack(X)  # XLA reads the numpy buffer itself (if aligned; else a copy)
+    return jax.tree_util.tree_map(lambda a: np.asarray(a)[..., :n], kernel(X))
+
+
+def _cotangents_of_columns(s2):
+    """The derived cot of the angle opposite side i of n triangles, for i = 0, 1, 2 (three (n,)
+    arrays), from their (3, n) squared side lengths by side (row i: side i, from corner i to
+    corner i + 1, opposite corner i + 2).
+
+    The Hessian of the sum of the n energies `dirichlet_energy` in their 3n vertex values is
+    block diagonal, so one Hessian-vector product (forward over reverse mode) with the direction
+    e_j at every triangle gives column j of every stiffness matrix K at once; all operations are
+    elementwise on (n,) arrays, which XLA fuses into a few loops (a `vmap` of `jax.hessian`
+    builds (n, 3, 3) blocks; stacking the three results into one array makes XLA compute each
+    of them three times).  cot(side i) = cot α_{i+2} = −2 K[i, i+1] (Thm 6.6): sides 0 and 2
+    from column 0 (K[1, 0], K[2, 0]), side 1 from column 2 (K[1, 2])."""
+    l2 = (s2[1], s2[2], s2[0])  # l2[k]: the side opposite corner k, side k + 1
+    zero = jnp.zeros_like(s2[0])
+    one = jnp.ones_like(zero)
+    gradient = jax.grad(lambda f: jnp.sum(dirichlet_energy(f, l2)))
+
+    def column(j):
+        return jax.jvp(gradient, ((zero,) * 3,), (tuple(one if k == j else zero for k in range(3)),))[1]
+
+    K0, K2 = column(0), column(2)
+    return -2.0 * K0[1], -2.0 * K2[1], -2.0 * K0[2]
+
+
+_side_cotangent_columns = jax.jit(_cotangents_of_columns)
+
+
 @jax.jit
-def _side_cotangents(s2):
-    # side i (corner i to i + 1) is opposite corner i + 2: l2[k] = s2[k + 1], cot(side i) = 2 w[i + 2]
-    l2 = s2[:, jnp.array([1, 2, 0])]
-    w = _off_diagonal(_stiffness(l2))
-    return 2.0 * w[:, jnp.array([2, 0, 1])], _area_from_squares(l2)
+def _side_cotangents_and_areas(s2):
+    return *_cotangents_of_columns(s2), triangle_area(jnp.sqrt(s2[0]), jnp.sqrt(s2[1]), jnp.sqrt(s2[2]))
+
+
+def side_cotangent_columns(s2, n: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(cot₀, cot₁, cot₂), each (n,): cot of the angle opposite side i of each of n triangles,
+    derived from the Dirichlet energy (the off-diagonal of its Hessian, Thm 6.6; `stiffness`
+    per face), for the (3, m) numpy squared lengths `s2` of their sides in halfedge order (row
+    i: side i, from corner i to corner i + 1), the triangles in the first n columns (default m).
+    Compiled for a few widths: an `s2` of width `padded_size(n)` whose extra columns are ones
+    is used as it is (no copy)."""
+    return _on_padded_columns(_side_cotangent_columns, s2, n)
 
 
 def side_cotangents(s2) -> tuple[np.ndarray, np.ndarray]:
     """`(cot, area)`: cot (nf, 3) of the angle opposite side i of each face, twice the derived
-    `corner_weights`, and the areas (nf,), for the (nf, 3) numpy squared lengths `s2` of the
-    sides in halfedge order (side i from corner i to corner i + 1); compiled for a few shapes."""
-    return _on_padded_rows(_side_cotangents, s2)
+    `corner_weights` (`side_cotangent_columns`), and the areas (nf,), for the (nf, 3) numpy
+    squared lengths `s2` of the sides in halfedge order (side i from corner i to corner i + 1);
+    compiled for a few shapes."""
+    *cot, area = _on_padded_columns(_side_cotangents_and_areas, np.ascontiguousarray(np.asarray(s2).T))
+    return np.stack(cot, axis=1), area
 
 
 def squared_side_lengths(P):
