@@ -11,11 +11,11 @@ the device exactly as for `KLU` (`AssembledSparse`), then
   factorisation it keeps;
 - `apply(token, b)` solves with that factorisation (Newton's damping test reuses it).
 
-The host keeps the two latest factorisations per batch member (`LIVE_PER_MEMBER`) and frees
-older ones: a Newton step's factorisation is dead once the next one is made, because the next
-step depends on the results of the current step's solves (the second one kept lets two solves of
-one pattern alternate; more concurrent solves of one pattern raise an error naming the freed
-factorisation).  XLA may run the callbacks on any of its threads, so nothing is kept per thread.
+The host keeps the latest factorisation per batch member (`LIVE_PER_MEMBER`) and frees older
+ones, reusing their memory: a Newton step's factorisation is dead once the next one is made,
+because the next step depends on the results of the current step's solves (two solves of one
+pattern running at once in two threads would free each other's: the solve that finds its
+factorisation gone raises an error naming it).  XLA may run the callbacks on any of its threads, so nothing is kept per thread.
 `jax.vmap` calls each callback once with the whole batch (`vmap_method="broadcast_all"`), which
 factorises every member and keeps them all.
 `jax.grad` works as on every back end (the adjoint is one more factorisation and solve, `K`
@@ -121,14 +121,14 @@ class Factorisation:
     handle: object = None  # the Pardiso handle holding the factors, returned to the pool when dead
 
 
-LIVE_PER_MEMBER = 2  # factorisations kept per batch member: the current one and one more (another stream)
+LIVE_PER_MEMBER = 1  # factorisations kept per batch member: the current one (a Newton step's is dead at the next)
 PIVOT_FLOOR = 1e-14  # an LDLᵀ pivot below this, relative to the largest, falls back to LU with pivoting
 
 
 @dataclass(eq=False)
 class HostFactors:
     """The host side of one pattern: its CSC structure, its symbolic analysis, and the live
-    numeric factorisations by token (the latest ones, `LIVE_PER_MEMBER` per member).  Pardiso keeps
+    numeric factorisations by token (the latest, `LIVE_PER_MEMBER` per member).  Pardiso keeps
     its analysis and factors in handles: a pool of them, each analysed once, taken by a
     factorisation and returned when it dies (usually one handle per pattern)."""
 
