@@ -40,6 +40,13 @@ sparse blocks of `K` (the same values as `method="sparse"`) and `M = |diag H|` (
 otherwise `K v` is a forward-over-reverse product of the Lagrangian (`jax.linearize`) and
 `M = I`.
 
+**Multigrid.**  `Krylov(preconditioner="amg")`, for an unconstrained problem declared local
+(a mesh): MINRES preconditioned by a smoothed-aggregation multigrid cycle of the Hessian
+(`_amg.py`: the aggregates made once per pattern on the host with pyamg; the prolongators,
+coarse operators and smoothers recomputed from the Hessian at every Newton step and the cycle
+applied inside `jit`) in place of the Jacobi metric; its iteration count stays nearly constant as the mesh is refined, where the Jacobi
+one grows with the condition number.
+
 **Accuracy.**  Each solve runs to the relative tolerance `rtol` (1e-12) in the preconditioned
 norm; near a solution Newton then converges as with a direct solve, to the same point.  The
 Levenberg–Marquardt fallback of `_newton.py` solves `(K² + ν I) d = −K R` by CG.
@@ -52,8 +59,13 @@ from typing import Callable
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax.scipy.sparse.linalg import cg, gmres
 
+from ddgjax._checks import is_concrete
+from ddgjax.errors import InvalidInputError
+
+from . import _amg as amg
 from . import _banded as banded
 from ._banded import Chain, chain_arrays, chain_structure
 from ._cache import derived
@@ -64,6 +76,7 @@ from ._sparse import PatternKey, SparsePattern, cached_pattern, index_arrays, kk
 RTOL = 1e-12
 CHAIN_RESTART, CHAIN_CYCLES = 10, 2  # GMRES with the block-tridiagonal preconditioner (border rank ≤ 2·3 for a chord)
 JACOBI_FLOOR = 1e-12  # |diag H| below this (relative to its largest entry) is raised to it
+PRECONDITIONERS = ("jacobi", "amg")
 
 
 def minres(A: Callable, b, precondition: Callable, *, rtol: float, maxiter: int, atol=0.0, lift: Callable | None = None):
@@ -150,6 +163,7 @@ class Factored:
     minv: object
     sinv: object  # the Jacobi preconditioner of S, or None
     chain: object = None  # the block-tridiagonal factors (`_banded.factor`), or None
+    amg: object = None  # the multigrid levels at this step (`_amg.setup`), or None
 
 
 def _sparse_linearisation(pattern: SparsePattern, index: dict, kkt: KKT, w, identity_hessian: bool) -> Linearisation:
@@ -207,22 +221,33 @@ def _autodiff_linearisation(kkt: KKT, w, identity_hessian: bool) -> Linearisatio
 class Krylov(LinearSolver):
     """Matrix-free KKT solves (module docstring): GMRES with the block-tridiagonal preconditioner
     on chains, MINRES on the constraints' tangent space otherwise, each to the relative
-    tolerance `rtol` in at most `maxiter` iterations (default 2N + 50).  A pytree: the
-    pattern's index arrays (if the problem is local) are its leaves."""
+    tolerance `rtol` in at most `maxiter` iterations (default 2N + 50).  `preconditioner="amg"`
+    replaces the Jacobi metric by a multigrid cycle (module docstring; unconstrained problems
+    declared local).  A pytree: the pattern's index arrays (if the problem is local) are its
+    leaves, and the multigrid hierarchy's."""
 
     def __init__(self, pattern: SparsePattern | None = None, rtol: float = RTOL, maxiter: int | None = None,
-                 index: dict | None = None, chain: Chain | None = None):
+                 index: dict | None = None, chain: Chain | None = None, preconditioner: str = "jacobi",
+                 hierarchy: amg.Hierarchy | None = None):
+        if preconditioner not in PRECONDITIONERS:
+            raise InvalidInputError(f"preconditioner must be one of {PRECONDITIONERS}, got {preconditioner!r}")
         self.pattern = pattern
         self.rtol = float(rtol)
         self.maxiter = maxiter
         self.chain = chain
+        self.preconditioner = preconditioner
+        self.hierarchy = hierarchy
         if index is None and pattern is not None:
-            index = dict(index_arrays(pattern), **({} if chain is None else chain_arrays(chain)))
+            index = dict(index_arrays(pattern), **({} if chain is None else chain_arrays(chain)),
+                         **({} if hierarchy is None else amg.device_arrays(hierarchy)))
         self.index = index
 
     def bind(self, problem, spec) -> Krylov:
         """Assembled products for a problem declared local, with the block-tridiagonal
-        preconditioner if it is a chain; autodiff products otherwise."""
+        preconditioner if it is a chain (or the multigrid one if asked); autodiff products
+        otherwise."""
+        if self.preconditioner == "amg":
+            return self._bind_amg(problem, spec)
         if not spec.is_local:
             return type(self)(None, self.rtol, self.maxiter)
         pattern = cached_pattern(spec, problem.x0, problem.params)
@@ -232,22 +257,44 @@ class Krylov(LinearSolver):
         chain = derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width))
         return type(self)(pattern, self.rtol, self.maxiter, chain=chain)
 
+    def _bind_amg(self, problem, spec) -> Krylov:
+        """The multigrid hierarchy of the Hessian's pattern, made once per pattern (with the
+        rotations of x0's rows in its near-null space when x0 is concrete)."""
+        if not spec.is_local:
+            raise InvalidInputError(
+                "Krylov(preconditioner='amg') assembles the Hessian: it needs an energy declared with "
+                "dg.local_sum over a single array of unknowns"
+            )
+        if spec.m:
+            raise InvalidInputError(
+                f"Krylov(preconditioner='amg') solves unconstrained problems; this one has {spec.m} constraints "
+                "(use Krylov() for the tangent-space MINRES with the Jacobi metric)"
+            )
+        pattern = cached_pattern(spec, problem.x0, problem.params)
+        hierarchy = derived(pattern, "amg", lambda: _hierarchy(pattern, spec, problem))
+        return type(self)(pattern, self.rtol, self.maxiter, preconditioner="amg", hierarchy=hierarchy)
+
     def __repr__(self):
-        return f"Krylov(rtol={self.rtol:g}, maxiter={self.maxiter})"
+        extra = "" if self.preconditioner == "jacobi" else f", preconditioner={self.preconditioner!r}"
+        return f"Krylov(rtol={self.rtol:g}, maxiter={self.maxiter}{extra})"
 
     def tree_flatten(self):
         names = () if self.index is None else tuple(sorted(self.index))
         key = None if self.pattern is None else PatternKey(self.pattern)
-        # the chain is found on the pattern (`of`), so that the static part compares by the
-        # pattern's structure only and problems declared alike share one compiled solver
-        return tuple(self.index[k] for k in names), (key, self.rtol, self.maxiter, names, self.chain is not None)
+        # the chain and the hierarchy are found on the pattern (`of`), so that the static part
+        # compares by the pattern's structure only and problems declared alike share one
+        # compiled solver
+        aux = (key, self.rtol, self.maxiter, names, self.chain is not None, self.preconditioner)
+        return tuple(self.index[k] for k in names), aux
 
     @classmethod
     def tree_unflatten(cls, aux, children):
-        key, rtol, maxiter, names, has_chain = aux
+        key, rtol, maxiter, names, has_chain, preconditioner = aux
         if key is None:
-            return cls(None, rtol, maxiter)
-        return cls(key.pattern, rtol, maxiter, dict(zip(names, children)), derived(key.pattern, "chain") if has_chain else None)
+            return cls(None, rtol, maxiter, preconditioner=preconditioner)
+        chain = derived(key.pattern, "chain") if has_chain else None
+        hierarchy = derived(key.pattern, "amg") if preconditioner == "amg" else None
+        return cls(key.pattern, rtol, maxiter, dict(zip(names, children)), chain, preconditioner, hierarchy)
 
     def matrix(self, kkt: KKT, w, identity_hessian=False) -> Linearisation:
         if self.pattern is not None:
@@ -267,7 +314,10 @@ class Krylov(LinearSolver):
         if K.m and K.jacobi_s is not None:
             s = K.jacobi_s(minv)
             sinv = 1.0 / jnp.where(s > 0, s, 1.0)
-        return Factored(K, mu, minv, sinv)
+        levels = None
+        if self.hierarchy is not None:
+            levels = amg.setup(self.hierarchy, self.index, K.values[self.index["h_at"]], mu)
+        return Factored(K, mu, minv, sinv, amg=levels)
 
     def _schur_solve(self, fac: Factored, r):
         """`S⁻¹ r`, `S = J M⁻¹ Jᵀ`, by Jacobi-preconditioned CG."""
@@ -288,8 +338,13 @@ class Krylov(LinearSolver):
         return minv * (r - K.vjp(self._schur_solve(fac, K.jvp(minv * r))))
 
     def apply(self, fac: Factored, b):
+        return self.apply_counted(fac, b)[0]
+
+    def apply_counted(self, fac: Factored, b):
+        """`(d, iterations)`: the solve of `apply` and its number of MINRES iterations (−1 for
+        the chain's GMRES)."""
         if fac.chain is not None:
-            return self._apply_chain(fac, b)
+            return self._apply_chain(fac, b), -1
         K, minv = fac.K, fac.minv
         n, m = K.n, K.m
         b1, b2 = b[:n], b[n:]
@@ -305,15 +360,19 @@ class Krylov(LinearSolver):
         # vectors then carry no large normal component that P would have to cancel in round-off
         if m:
             rhs = rhs - K.vjp(self._schur_solve(fac, K.jvp(minv * rhs)))  # = M P rhs
-        d_t, _, _ = minres(
-            H, rhs, lambda r: self._project(fac, r), rtol=self.rtol, atol=self.rtol * scale, maxiter=maxiter,
+        if fac.amg is not None:  # m = 0; the tolerance is relative to the cycle's norm of rhs
+            precondition, atol = (lambda r: amg.precondition(self.hierarchy, self.index, fac.amg, r)), 0.0
+        else:
+            precondition, atol = (lambda r: self._project(fac, r)), self.rtol * scale
+        d_t, iterations, _ = minres(
+            H, rhs, precondition, rtol=self.rtol, atol=atol, maxiter=maxiter,
             lift=(lambda y: y / minv) if m else None,
         )
         d1 = d_n + d_t
         if not m:
-            return d1
+            return d1, iterations
         d2 = self._schur_solve(fac, K.jvp(minv * (H(d1) - b1)))
-        return jnp.concatenate([d1, d2])
+        return jnp.concatenate([d1, d2]), iterations
 
     def _apply_chain(self, fac: Factored, b):
         """GMRES on `(K + μS) d = b` preconditioned by the block-tridiagonal solve (`_banded`)."""
@@ -342,6 +401,17 @@ class Krylov(LinearSolver):
 
         d, _ = cg(normal, -K.kvp(R), tol=self.rtol, atol=0.0, maxiter=2 * size + 50)
         return d
+
+
+def _hierarchy(pattern: SparsePattern, spec, problem) -> amg.Hierarchy:
+    """`_amg.build_hierarchy` for the Hessian block of the pattern, with the rows of x at x0 for
+    the rotations when they are concrete."""
+    h_at, _ = pattern.blocks()
+    shape = spec.layout.shapes[0]
+    width = shape[1] if len(shape) == 2 else 1
+    coords = np.asarray(spec.layout.ravel(problem.x0)).reshape(-1, width) if is_concrete(problem.x0) else None
+    return amg.build_hierarchy(np.asarray(spec.layout.free, np.int64), width, pattern.rows[h_at].astype(np.int64),
+                               pattern.cols[h_at].astype(np.int64), coords)
 
 
 __all__ = ["Krylov", "minres"]
