@@ -39,6 +39,7 @@ import numpy as np
 
 import ddgjax as dg  # noqa: F401  (float64)
 from energies import area, elastica
+from ddgjax.mesh import saddle_grid
 from solvers import KLU, solve
 
 
@@ -73,24 +74,6 @@ def elastica_problem(n: int):
     if "T" not in _COARSE:
         _COARSE["T"] = np.asarray(solve(elastica.clamped(64, **ELASTICA), tol=1e-10).x)
     return elastica.clamped(n, **ELASTICA, x0=elastica.resample(_COARSE["T"], n))
-
-
-def saddle_grid(k: int, seed: int = 0):
-    """(V, F, boundary) of a k×k grid on [−1, 1]², z on the saddle (+ interior noise)."""
-    x = np.linspace(-1.0, 1.0, k)
-    X, Y = np.meshgrid(x, x, indexing="ij")
-    Z = 0.25 * (X**2 - Y**2)
-    V = np.stack([X, Y, Z], -1).reshape(-1, 3)
-    idx = np.arange(k * k).reshape(k, k)
-    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
-    F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
-    border = np.zeros((k, k), bool)
-    border[[0, -1], :] = border[:, [0, -1]] = True
-    boundary = idx[border]
-    interior = ~border.ravel()
-    h = 2.0 / (k - 1)
-    V[interior, 2] += 0.1 * h * np.random.default_rng(seed).normal(size=int(interior.sum()))
-    return V, F, boundary
 
 
 def area_problem(k: int, cotan_steps: int = 5):

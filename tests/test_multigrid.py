@@ -11,6 +11,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+import ddgjax as dg
 from ddgjax.errors import InvalidInputError
 from energies import area
 from solvers import Krylov, SparseDirect, solve
@@ -20,19 +21,11 @@ from solvers._newton import NEWTON_MU
 
 
 def _saddle(k: int):
-    """A k×k grid on [−1, 1]², border on the saddle z = (x² − y²)/4, interior noisy, after two
-    Pinkall–Polthier steps (as `benchmarks/scale.py`, smaller)."""
-    x = np.linspace(-1.0, 1.0, k)
-    X, Y = np.meshgrid(x, x, indexing="ij")
-    V = np.stack([X, Y, 0.25 * (X**2 - Y**2)], -1).reshape(-1, 3)
-    idx = np.arange(k * k).reshape(k, k)
-    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
-    F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
-    border = np.zeros((k, k), bool)
-    border[[0, -1], :] = border[:, [0, -1]] = True
-    V[~border.ravel(), 2] += 0.2 / (k - 1) * np.random.default_rng(0).normal(size=int((~border).sum()))
-    W = area.minimal_surface(V, F, idx[border], method="cotan", max_iter=2, throw=False)[0]
-    return area.simplicial(W, F, idx[border])
+    """The saddle grid (`mesh.saddle_grid`, as `benchmarks/scale.py`, smaller) after two
+    Pinkall–Polthier steps."""
+    V, F, boundary = dg.mesh.saddle_grid(k)
+    W = area.minimal_surface(V, F, boundary, method="cotan", max_iter=2, throw=False)[0]
+    return area.simplicial(W, F, boundary)
 
 
 def _first_step_iterations(problem, linear_solver):

@@ -9,7 +9,7 @@ a gluing word ("abAB") or `Halfedges`.  Surfaces may be non-orientable and have 
   `boundary_loops`, `genus`, `crosscaps`, `classification`, `classify`, `is_regular`,
   `is_strongly_regular`
 - gluing: `from_word`, `connected_sum`, `normal_form`
-- builtin: `tetrahedron`, `cube`, `octahedron`, `icosahedron`, `icosphere`, `torus`,
+- builtin: `saddle_grid`, `tetrahedron`, `cube`, `octahedron`, `icosahedron`, `icosphere`, `torus`,
   `projective_plane`, `klein_bottle`, `double_torus`, `disk`, `annulus`, `mobius_strip`
 - curvature: `corner_angles`, `angle_defect`, `vertex_kind`, `surface_area`, `dihedral_angles`,
   `edge_mean_curvature`, `total_mean_curvature`, `steiner_area`
@@ -49,6 +49,9 @@ from .builtin import (
 )
 from .builtin import (
     projective_plane as projective_plane,
+)
+from .builtin import (
+    saddle_grid as saddle_grid,
 )
 from .builtin import (
     tetrahedron as tetrahedron,

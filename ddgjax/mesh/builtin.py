@@ -25,6 +25,7 @@ __all__ = [
     "klein_bottle",
     "double_torus",
     "disk",
+    "saddle_grid",
     "annulus",
     "mobius_strip",
     "grid_quads",
@@ -199,6 +200,30 @@ def double_torus():
     occupied = np.ones((3, 5, 1), dtype=bool)
     occupied[1, 1, 0] = occupied[1, 3, 0] = False
     return _voxel_boundary(occupied)
+
+
+def saddle_grid(k: int, *, noise: float = 0.1, seed: int = 0):
+    """`(V, F, boundary)`: a k×k grid on [−1, 1]², two triangles per square, on the saddle
+    z = (x² − y²)/4, the interior vertices' z moved by `noise` × h × N(0, 1) (h = 2/(k − 1),
+    generator `seed`); `boundary` the indices of the border vertices.  The test surface of the
+    minimal-surface solves (Fig 6.5)."""
+    _check_grid(k=(k, 2))
+    x = np.linspace(-1.0, 1.0, k)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    V = np.stack([X, Y, 0.25 * (X**2 - Y**2)], -1).reshape(-1, 3)
+    F = _grid_triangles(k)
+    border = np.zeros((k, k), bool)
+    border[[0, -1], :] = border[:, [0, -1]] = True
+    interior = ~border.ravel()
+    V[interior, 2] += noise * (2.0 / (k - 1)) * np.random.default_rng(seed).normal(size=int(interior.sum()))
+    return V, F, np.arange(k * k).reshape(k, k)[border]
+
+
+def _grid_triangles(k: int) -> np.ndarray:
+    """The k×k vertex grid's squares (a, b, c, d) split into (a, b, c) and (a, c, d)."""
+    idx = np.arange(k * k).reshape(k, k)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    return np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
 
 
 def disk(rings: int = 4, m: int = 12):
