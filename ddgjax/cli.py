@@ -7,7 +7,8 @@
     ddgjax bench [--quick] [NAME ...]
 
 Exit codes: 0 success, 1 a check failed (verify) or a benchmark script failed (bench), 2 bad
-input: a `DDGError` is printed as one line `ddgjax: error: … (hint: …)`, without a traceback
+input: a `DDGError` (also a malformed argument, a mesh file that cannot be read, an output path
+that cannot be written) is printed as one line `ddgjax: error: … (hint: …)`, without a traceback
 unless `--debug`.
 """
 
@@ -17,6 +18,7 @@ import argparse
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -32,6 +34,10 @@ HINTS = {
     "ShapeError": "vectors take three numbers, e.g. --chord 0.5 0 0",
     "MeshError": "the mesh must be a valid surface (see `ddgjax.mesh.classify`)",
     "NotAvailableError": "this object is still being implemented; see README for what exists",
+    "MeshFileError": "give a surface mesh file (OBJ, OFF, PLY, STL or VTK), or annulus or disk",
+    "OutputPathError": "choose a path you can write to (a figure's ending in .png, .pdf or .svg)",
+    "UsageError": "see `ddgjax --help` and `ddgjax <command> --help`",
+    "OSError": "check the paths in the arguments",
 }
 
 
@@ -39,7 +45,66 @@ class NotAvailableError(InvalidInputError):
     """A command needs a part of the library that is not there yet."""
 
 
-def hint_for(error: DDGError) -> str:
+class OutputPathError(InvalidInputError):
+    """An output path (`--out`, `--plot`) cannot be created or written."""
+
+
+class UsageError(InvalidInputError):
+    """The command line does not parse: an unknown option, a missing or malformed value."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are `UsageError`s, printed by `main` as one line."""
+
+    def error(self, message: str):
+        command = self.prog.split(" ", 1)[1:]  # "ddgjax verify" -> ["verify"]
+        raise UsageError(f"{command[0]}: {message}" if command else message)
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}")
+    return value
+
+
+def _writable_directory(path) -> Path:
+    """`path` if it is, or can be created as, a directory to write in: its nearest existing
+    ancestor is a directory in which a temporary file can be written (nothing is left behind);
+    else `OutputPathError` naming the path and the reason."""
+    path = Path(path)
+    existing = next(p for p in (path, *path.parents) if p.exists())
+    if not existing.is_dir():
+        raise OutputPathError(f"cannot write in the directory {path}: {existing} is not a directory")
+    try:
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as error:
+        where = "" if existing == path else f"{existing}: "
+        raise OutputPathError(f"cannot write in the directory {path}: {where}{error.strerror or error}") from None
+    return path
+
+
+def _writable_figure(path) -> Path:
+    """`path` for `savefig`: its directory writable (`_writable_directory`), not itself a
+    directory, its extension one matplotlib writes; else `OutputPathError`."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    path = Path(path)
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if path.suffix and path.suffix[1:].lower() not in formats:
+        raise OutputPathError(f"cannot save a figure as {path}: unknown format {path.suffix!r} (use one of "
+                              f"{', '.join(sorted(formats))})")
+    _writable_directory(path.parent)
+    if path.is_dir() or (path.exists() and not os.access(path, os.W_OK)):
+        raise OutputPathError(f"cannot write the figure {path}: it is a directory or read-only")
+    return path
+
+
+def hint_for(error: Exception) -> str:
     """A short suggestion for the user, by the error's class (most specific first)."""
     for cls in type(error).__mro__:
         if cls.__name__ in HINTS:
@@ -48,6 +113,8 @@ def hint_for(error: DDGError) -> str:
 
 
 def _one_line(error: BaseException) -> str:
+    if isinstance(error, OSError) and error.filename is not None:
+        return f"{error.filename}: {error.strerror}"
     return " ".join(str(error).split()) or type(error).__name__
 
 
@@ -62,6 +129,7 @@ def _verify(args) -> int:
         for c in v.select(args.only):
             print(f"{c.name:45s} {c.reference:25s} {c.statement}")
         return 0
+    _writable_directory(args.out)
     start = time.perf_counter()
     outcomes, path = v.verify(args.out, quick=args.quick, only=args.only, progress=not args.no_progress, debug=args.debug,
                               jobs=args.jobs)
@@ -170,7 +238,10 @@ def _solve_minimal_surface(args) -> int:
             V[np.linalg.norm(V[:, :2], axis=1) < 0.75, 2] = args.height
     else:
         V, F = mesh.read(args.mesh)
-    boundary = np.unique(np.concatenate(mesh.boundary_loops(F)))
+    loops = mesh.boundary_loops(F)
+    if not loops:
+        raise InvalidInputError(f"the mesh {args.mesh} is closed: a minimal surface spans a boundary, and it has none")
+    boundary = np.unique(np.concatenate(loops))
     options = {k: v for k, v in (("tol", args.tol), ("max_iter", args.max_steps)) if v is not None}
     V, F, info = area.minimal_surface(V, F, boundary, method=args.method, **options)
     print(f"vertices      {len(V)}, faces {len(F)}")
@@ -189,7 +260,7 @@ SOLVERS = {"elastica": _solve_elastica, "rod": _solve_rod, "minimal-surface": _s
 
 def _solve(args) -> int:
     if args.plot:
-        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
+        _writable_figure(args.plot).parent.mkdir(parents=True, exist_ok=True)
     return SOLVERS[args.object](args)
 
 
@@ -225,7 +296,7 @@ def _vector(name: str, default):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="ddgjax", description="Variational discrete differential geometry in JAX.")
+    parser = _Parser(prog="ddgjax", description="Variational discrete differential geometry in JAX.")
     parser.add_argument("--debug", action="store_true", help="show tracebacks instead of one-line errors")
     commands = parser.add_subparsers(dest="command", required=True)
 
@@ -235,7 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("--only", nargs="+", metavar="WORD", help="run the checks whose name, reference or module contains WORD")
     verify.add_argument("--list", action="store_true", help="list the checks and exit")
     verify.add_argument("--no-progress", action="store_true", help="no progress bar")
-    verify.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
+    verify.add_argument("--jobs", type=_positive_int, default=min(2, os.cpu_count() or 1),
                         help="worker processes (default: 2, or 1 on a single core)")
     verify.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                         help="stop at the first failing check with its traceback")
@@ -270,12 +341,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit code (also used by the `ddgjax` entry point)."""
-    args = build_parser().parse_args(argv)
+    """Run the command line; returns the exit code (also used by the `ddgjax` entry point).
+
+    A `DDGError` or an `OSError` (a path that cannot be read or written) is one line on stderr
+    and exit code 2, or its traceback with `--debug`.
+    """
+    args = None
     try:
+        args = build_parser().parse_args(argv)
         return args.run(args)
-    except DDGError as error:
-        if args.debug:
+    except (DDGError, OSError) as error:
+        if getattr(args, "debug", False):
             raise
         print(f"ddgjax: error: {_one_line(error)} (hint: {hint_for(error)})", file=sys.stderr)
         return 2

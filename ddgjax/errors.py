@@ -19,6 +19,7 @@ __all__ = [
     "ArcLengthError",
     "SingularVertexError",
     "MeshError",
+    "MeshFileError",
     "NonManifoldError",
     "OrientationError",
     "TriangleInequalityError",
@@ -87,6 +88,23 @@ class MeshError(InvalidInputError):
     """A face list or cell decomposition is not a valid surface (Def 4.3); the message names the
     offending vertex, edge or face index.
     """
+
+
+class MeshFileError(MeshError):
+    """A mesh file cannot be read as a surface: it is missing or unreadable, malformed or
+    truncated, its header promises more data than the file holds, a coordinate is NaN or
+    infinite, or a face refers to a vertex that is not there.  The message names the file and
+    the offending line, vertex or face.
+
+    **Attributes:** `path`: the file; `reason`: what is wrong with it.
+    """
+
+    def __init__(self, path, reason: str):
+        super().__init__(f"{path}: {reason}")
+        self.path, self.reason = path, reason
+
+    def __reduce__(self):
+        return type(self), (self.path, self.reason)
 
 
 class NonManifoldError(MeshError):

@@ -17,6 +17,8 @@ a gluing word ("abAB") or `Halfedges`.  Surfaces may be non-orientable and have 
   `corner_angles_from_lengths`, `angle_defect_from_lengths`, `corner_cotangents`,
   `dirichlet_energy`, `stiffness`
 - io: `read`, `write` (meshio)
+- cleanup (each returns `(V, F, CleanupReport)`): `remove_unreferenced_vertices`, `weld_vertices`,
+  `split_nonmanifold_vertices`, `drop_degenerate_faces`
 """
 
 from . import lengths as lengths
@@ -61,6 +63,21 @@ from .builtin import (
 )
 from .builtin import (
     triangulate as triangulate,
+)
+from .cleanup import (
+    CleanupReport as CleanupReport,
+)
+from .cleanup import (
+    drop_degenerate_faces as drop_degenerate_faces,
+)
+from .cleanup import (
+    remove_unreferenced_vertices as remove_unreferenced_vertices,
+)
+from .cleanup import (
+    split_nonmanifold_vertices as split_nonmanifold_vertices,
+)
+from .cleanup import (
+    weld_vertices as weld_vertices,
 )
 from .connectivity import (
     Halfedges as Halfedges,

@@ -49,9 +49,13 @@ def tetrahedron():
 
 
 def triangulate(F) -> np.ndarray:
-    """Split each convex k-gon of an (nf, k) array into k − 2 triangles by a fan from its first
-    corner, keeping the orientation.
+    """Split each convex k-gon into k − 2 triangles by a fan from its first corner, keeping the
+    orientation.  `F` is an (nf, k) array or a list of polygons of any sizes (what `read` returns
+    for a file mixing triangles and quads); the triangles of each face stay together, in face order.
     """
+    if not hasattr(F, "shape"):
+        fans = [[f[0], f[i], f[i + 1]] for f in F for i in range(1, len(f) - 1)]
+        return np.asarray(fans, dtype=np.int64).reshape(-1, 3)
     F = np.asarray(F)
     k = F.shape[1]
     fans = [F[:, [0, i, i + 1]] for i in range(1, k - 1)]
