@@ -23,9 +23,9 @@ import numpy as np
 from jax.flatten_util import ravel_pytree
 from jaxtyping import Array, Float
 
-from ._checks import check_finite, is_concrete
+from ._checks import check_finite, check_same_structure, is_concrete
 from ._flat import layout_of
-from .errors import ConvergenceError, InvalidInputError
+from .errors import ConvergenceError, InvalidInputError, ShapeError
 from .problem import Problem, constraint_values
 
 __all__ = ["gradient_flow", "hamiltonian_flow", "spin_poisson", "lie_bracket", "integrate"]
@@ -36,10 +36,14 @@ def gradient_flow(problem: Problem) -> Callable:
 
     The velocity is tangent to the constraint set (`Jg(x) f(x) = 0`) and zero on fixed
     entries; along it the energy decreases, `dE/dt = −|f|²`.  Uses `problem.params`.
+
+    **Raises** (when `f` is called): `ShapeError` unless `x` has the structure and shapes of
+    `problem.x0` (naming the leaf, the expected and the given shape).
     """
     layout = layout_of(problem)
 
     def f(x):
+        check_same_structure(problem.x0, x, "x", "problem.x0")
         z = layout.ravel(x)
         u = z[layout.free]
 
@@ -69,15 +73,27 @@ def hamiltonian_flow(H: Callable, poisson: Callable) -> Callable:
 
 
 def spin_poisson(S: Float[Array, "n 3"], dH: Float[Array, "n 3"]) -> Float[Array, "n 3"]:
-    """Lie–Poisson tensor of spin chains: `Ṡ_i = ∇_i H × S_i` (Appendix A, (A.2))."""
+    """Lie–Poisson tensor of spin chains: `Ṡ_i = ∇_i H × S_i` (Appendix A, (A.2)).
+
+    **Raises:** `ShapeError` unless S is (n, 3) and dH has its shape (naming both shapes).
+    """
+    if np.ndim(S) != 2 or np.shape(S)[1] != 3:
+        raise ShapeError(f"spins S must have shape (n, 3), one spin in R³ per row, got {np.shape(S)}")
+    if np.shape(dH) != np.shape(S):
+        raise ShapeError(f"the gradient dH must have the shape of S, {np.shape(S)}, got {np.shape(dH)}")
     return jnp.cross(dH, S)
 
 
 def lie_bracket(f: Callable, g: Callable) -> Callable:
-    """`h(x) = Dg(x) f(x) − Df(x) g(x)`, by Jacobian-vector products (works on pytrees)."""
+    """`h(x) = Dg(x) f(x) − Df(x) g(x)`, by Jacobian-vector products (works on pytrees).
+
+    **Raises:** `ShapeError` unless `f(x)` and `g(x)` have the structure and shapes of `x`.
+    """
 
     def h(x):
         fx, gx = f(x), g(x)
+        check_same_structure(x, fx, "f(x)", "x")
+        check_same_structure(x, gx, "g(x)", "x")
         dg_f = jax.jvp(g, (x,), (fx,))[1]
         df_g = jax.jvp(f, (x,), (gx,))[1]
         return jax.tree_util.tree_map(jnp.subtract, dg_f, df_g)
@@ -172,9 +188,12 @@ def integrate(
     - `constraints(x) -> 1-D`: keep the iterates on `{constraints = 0}` by projecting after
       every step (every saved time for `"dopri8"`).
 
-    **Raises:** `NonFiniteError` for NaN in `x0`, `InvalidInputError` for bad options.
+    **Raises:** `NonFiniteError` for NaN in `x0`, `ShapeError` unless `f(x0)` has the structure
+    and shapes of `x0` (naming the expected and the given shape), `InvalidInputError` for bad
+    options.
     """
     check_finite(x0, "x0")
+    check_same_structure(x0, jax.eval_shape(f, x0), "f(x0)", "x0")
     method = method or ("gauss6" if steps is not None else "dopri8")
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {tuple(METHODS)}, got {method!r}")

@@ -20,6 +20,7 @@ iterations of `energies.area`).
 
 from __future__ import annotations
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import scipy.sparse as sp
@@ -28,7 +29,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import splu
 
 import ddgjax as dg
-from ddgjax._checks import check_finite
+from ddgjax._checks import check_finite, concrete_value
 from ddgjax.errors import NonUniqueSolutionError, ShapeError
 from ddgjax.laplace import (
     checked_graph,
@@ -36,6 +37,7 @@ from ddgjax.laplace import (
     triangle_dirichlet_energy,
 )
 from ddgjax.mesh import boundary_indices
+from ddgjax.mesh.connectivity import checked_triangles, from_faces
 
 __all__ = ["check_unique", "cotan", "cotan_sparse", "dirichlet_solve", "edge_energy", "graph", "graph_sparse"]
 
@@ -58,25 +60,37 @@ def _face_term(f3, k, params):
     return triangle_dirichlet_energy(f3, params["triangles"][k])
 
 
-def _boundary_data(n: int, boundary, values) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """`(V₀, c, x0)`: validated boundary indices and values and the start (c on V₀, the mean
-    of c elsewhere)."""
+def _boundary_data(n: int, boundary, values) -> tuple[np.ndarray, jax.Array]:
+    """`(V₀, c)`: validated boundary indices and values (c traceable)."""
     b = boundary_indices(boundary, n)
-    c = np.array(values, dtype=np.float64).reshape(-1)
+    c = jnp.asarray(values, dtype=float).reshape(-1)
     if c.shape != (b.size,):
         raise ShapeError(f"values must have shape ({b.size},), one per boundary vertex, got {np.shape(values)}")
     check_finite(c, "values")
-    x0 = np.full(n, c.mean() if c.size else 0.0)
-    x0[b] = c
-    return b, c, x0
+    return b, c
+
+
+def _start(n: int, b: np.ndarray, c: jax.Array) -> jax.Array:
+    """c on V₀ (traced: the solution is differentiable in c through these fixed entries) and the
+    mean of c elsewhere (no derivative: the solution's does not depend on the start)."""
+    fill = jax.lax.stop_gradient(c.mean()) if c.size else 0.0
+    return jnp.full(n, fill).at[b].set(c)
 
 
 def _problem(energy, params, L, n: int, boundary, values, name: str) -> dg.Problem:
-    b, _, x0 = _boundary_data(n, boundary, values)
+    b, c = _boundary_data(n, boundary, values)
+    x0 = _start(n, b, c)
     check_unique(L, b)
     fixed = np.zeros(n, dtype=bool)
     fixed[b] = True
     return dg.Problem(energy, x0, params=params, fixed=fixed, name=name)
+
+
+def _known_or(value: jax.Array, stand_in: np.ndarray) -> np.ndarray:
+    """The concrete value of a parameter, or `stand_in` when it is traced abstractly (under `jit`
+    or `vmap`): the structure is then checked with the stand-in, the values are not."""
+    known = concrete_value(value)
+    return stand_in if known is None else known
 
 
 def graph(edges, weights, boundary, values, *, n_vertices: int | None = None) -> dg.Problem:
@@ -84,34 +98,49 @@ def graph(edges, weights, boundary, values, *, n_vertices: int | None = None) ->
 
     **Arguments:** `edges` (ne, 2) int; `weights` ν (ne,); `boundary` vertex indices (or a bool
     mask); `values` c (nb,), ordered like `boundary`; `n_vertices` (default max index + 1).
-    Unknowns: f (nv,); `params = {"weights": ν}` (so `solve` is differentiable in the weights).
+    Unknowns: f (nv,); `params = {"weights": ν}`.  Differentiable in ν and c (traced values
+    enter `params` and the fixed entries of `x0`).
 
     **Raises:** `NonUniqueSolutionError` when a connected component has no boundary vertex
     (naming a vertex of it); `InvalidInputError` for a boundary vertex that does not exist or a
-    bad edge (naming it); `NonFiniteError` for NaN weights or values; `ShapeError`.
+    bad edge (naming it); `NonFiniteError` for NaN weights or values; `ShapeError`.  Weights and
+    values are checked when concrete; under `jit`/`vmap` every edge counts as connecting.
     """
-    edges, weights, n = checked_graph(edges, weights, n_vertices)
+    weights = jnp.asarray(weights, dtype=float)
+    edges, known, n = checked_graph(edges, _known_or(weights, np.ones(np.shape(weights))), n_vertices)
     energy = dg.local_sum(_edge_term, edges, data=np.arange(len(edges)))
-    L = dg.laplace.graph_laplacian(edges, weights, n)
-    params = {"weights": jnp.asarray(weights)}
-    return _problem(energy, params, L, n, boundary, values, f"graph Dirichlet energy (nv={n}, ne={len(edges)})")
+    L = dg.laplace.graph_laplacian(edges, known, n)
+    return _problem(energy, {"weights": weights}, L, n, boundary, values, f"graph Dirichlet energy (nv={n}, ne={len(edges)})")
+
+
+def _mesh_laplacian(V: jax.Array, F) -> tuple[np.ndarray, sp.spmatrix]:
+    """`(F, L)`: the checked faces and the cotan Laplacian of concrete positions V, or the mesh
+    graph's Laplacian (same connectivity) when V is traced abstractly (under `jit`/`vmap`)."""
+    known = concrete_value(V)
+    if known is not None:
+        V, F = checked_triangle_mesh(known, F, manifold=True)
+        return F, dg.laplace.cotan_laplacian(V, F)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ShapeError(f"V must be an (nv, 3) array of positions, got shape {V.shape}")
+    F, n = checked_triangles(F, V.shape[0])
+    E = from_faces(F, n_vertices=n).edges
+    return F, dg.laplace.graph_laplacian(E, np.ones(len(E)), n)
 
 
 def cotan(V, F, boundary, values) -> dg.Problem:
     """The Dirichlet energy of piecewise affine functions on the triangle mesh (V, F) (Thm 6.6)
     with f = c fixed on V₀ = `boundary`; unknowns f (nv,); `params = {"triangles": V[F]}` (nf, 3, 3),
-    the positions, in which `solve` is differentiable.
+    the positions.  Differentiable in V and c (traced values enter `params` and `x0`).
 
     **Raises:** as `graph`, and `NonFiniteError` (NaN position, naming the vertex),
     `DegenerateFaceError` (zero-area face), `MeshError` / `NonManifoldError` (naming the face,
-    edge or vertex).
+    edge or vertex).  Positions are checked when concrete.
     """
-    V, F = checked_triangle_mesh(V, F, manifold=True)
-    L = dg.laplace.cotan_laplacian(V, F)
+    V = jnp.asarray(V, dtype=float)
+    F, L = _mesh_laplacian(V, F)
     energy = dg.local_sum(_face_term, F, data=np.arange(len(F)))
-    params = {"triangles": jnp.asarray(V[F])}
     name = f"cotan Dirichlet energy (nv={V.shape[0]}, nf={len(F)})"
-    return _problem(energy, params, L, V.shape[0], boundary, values, name)
+    return _problem(energy, {"triangles": V[F]}, L, V.shape[0], boundary, values, name)
 
 
 def check_unique(L: sp.spmatrix, boundary: np.ndarray) -> None:
@@ -176,7 +205,7 @@ def graph_sparse(edges, weights, boundary, values, *, n_vertices: int | None = N
     """The solution f (nv,) of the problem `graph(...)` by one sparse LU solve (same arguments,
     same errors): the fast path for large graphs."""
     L = dg.laplace.graph_laplacian(edges, weights, n_vertices)
-    b, c, _ = _boundary_data(L.shape[0], boundary, values)
+    b, c = _boundary_data(L.shape[0], boundary, values)
     return dirichlet_solve(L, b, c)
 
 
@@ -185,5 +214,5 @@ def cotan_sparse(V, F, boundary, values) -> np.ndarray:
     same errors)."""
     V, F = checked_triangle_mesh(V, F, manifold=True)
     L = dg.laplace.cotan_laplacian(V, F)
-    b, c, _ = _boundary_data(V.shape[0], boundary, values)
+    b, c = _boundary_data(V.shape[0], boundary, values)
     return dirichlet_solve(L, b, c)

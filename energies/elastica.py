@@ -48,7 +48,8 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
-from ddgjax.errors import InvalidInputError, ShapeError
+from ddgjax._checks import check_positive, checked_count, checked_shape, concrete_value, when_concrete
+from ddgjax.errors import InvalidInputError, NonFiniteError
 
 __all__ = [
     "bending_density",
@@ -58,6 +59,7 @@ __all__ = [
     "load",
     "resample",
     "great_circle",
+    "unit_vector",
     "theorem_3_8_a",
     "pendulum_gravity",
     "edge_length",
@@ -127,76 +129,125 @@ def unit_and_chord(free_edges: np.ndarray, n: int, unit=_unit, chord=_chord) -> 
     )
 
 
-def edge_length(problem: dg.Problem) -> float:
+def edge_length(problem: dg.Problem) -> Float[Array, ""]:
     return problem.params["h"]
 
 
-def _unit_vector(v, name: str) -> np.ndarray:
-    v = np.array(v, dtype=float)
-    if v.shape != (3,):
-        raise ShapeError(f"{name} must be a vector of shape (3,), got {v.shape}")
+@when_concrete
+def _check_nonzero(v, name: str) -> None:
     norm = np.linalg.norm(v)
     if not np.isfinite(norm) or norm == 0:
         raise InvalidInputError(f"{name} must be a finite non-zero vector, got {v}")
-    return v / norm
 
 
-def great_circle(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Points of the great-circle arc from the unit vector a (s = 0) to b (s = 1), at s (len m)."""
-    angle = np.arccos(np.clip(a @ b, -1.0, 1.0))
-    if angle < 1e-12:
-        return np.broadcast_to(a, (len(s), 3)).copy()
-    if np.pi - angle < 1e-9:  # antipodal: go through any perpendicular direction
-        perp = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
-        mid = perp / np.linalg.norm(perp)
-        return np.concatenate([great_circle(a, mid, s[s < 0.5] * 2), great_circle(mid, b, s[s >= 0.5] * 2 - 1)])
-    return (np.sin((1 - s)[:, None] * angle) * a + np.sin(s[:, None] * angle) * b) / np.sin(angle)
+def unit_vector(v, name: str) -> Float[Array, "3"]:
+    """`v / |v|` for a vector `v` of shape (3,), traceable (a clamp direction, an end tangent).
+
+    **Raises:** `ShapeError` for another shape; when `v` is concrete, `InvalidInputError` unless
+    it is finite and non-zero (naming it).
+    """
+    v = jnp.asarray(v, dtype=float)
+    checked_shape(v, (3,), name)
+    _check_nonzero(v, name)
+    return v / jnp.linalg.norm(v)
 
 
-def checked_chord(chord, length: float) -> np.ndarray:
-    """The chord as a (3,) array, or `InfeasibleChordError` if |chord| ≥ length (no bent
-    arc-length curve of that length has it)."""
-    if not (length > 0):
-        raise InvalidInputError(f"length must be positive, got {length}")
-    chord = np.array(chord, dtype=float)
-    if chord.shape != (3,) or not np.all(np.isfinite(chord)):
-        raise ShapeError(f"chord must be a finite vector of shape (3,), got {chord}")
+def start_data(*values):
+    """`(xp, values)` for computing a default start: NumPy and the values as NumPy arrays when
+    all are concrete (no compilation), else `jax.numpy` and the values without derivative.
+
+    The start carries no derivative either way: the solution's derivative with respect to the
+    parameters does not depend on the start (implicit function theorem), only on the fixed
+    entries, which the constructors set from the traced parameters themselves.
+    """
+    known = [concrete_value(v) for v in values]
+    if all(k is not None for k in known):
+        return np, known
+    return jnp, [jax.lax.stop_gradient(jnp.asarray(v, dtype=float)) for v in values]
+
+
+def _perpendicular(a, xp=np):
+    """A unit vector orthogonal to the unit vector a (a × e1, or a × e2 when a is near e1)."""
+    helper = xp.where(xp.abs(a[0]) < 0.9, xp.asarray([1.0, 0.0, 0.0]), xp.asarray([0.0, 1.0, 0.0]))
+    p = xp.cross(a, helper)
+    return p / xp.linalg.norm(p)
+
+
+def great_circle(a, b, s, xp=np):
+    """Points `cos(θs) a + sin(θs) u` (len(s), 3) of the great-circle arc from the unit vector a
+    (s = 0) to b (s = 1): θ = ∠(a, b) and u the unit vector orthogonal to a in the plane of a, b
+    (through `_perpendicular(a)` when b = ±a).  `xp`: the array module (NumPy or jax.numpy)."""
+    a, b, s = xp.asarray(a, dtype=float), xp.asarray(b, dtype=float), xp.asarray(s, dtype=float)
+    u = b - (a @ b) * a
+    norm = xp.linalg.norm(u)  # sin θ
+    u = xp.where(norm > 1e-9, u / xp.where(norm > 1e-9, norm, 1.0), _perpendicular(a, xp))
+    angle = xp.arctan2(norm, a @ b) * s[:, None]  # accurate at θ ≈ 0 and θ ≈ π, unlike arccos
+    return xp.cos(angle) * a + xp.sin(angle) * u
+
+
+@when_concrete
+def _check_feasible_chord(chord, length, name: str) -> None:
+    if not np.all(np.isfinite(chord)):
+        raise NonFiniteError(f"{name} must be finite, got {chord}")
     if np.linalg.norm(chord) >= length:
         raise InfeasibleChordError(
-            f"the chord |γ_n − γ_0| = {np.linalg.norm(chord):.6g} is not shorter than the length "
-            f"{length:.6g}: no bent arc-length curve has it (infeasible)"
+            f"the {name} |γ_n − γ_0| = {np.linalg.norm(chord):.6g} is not shorter than the length "
+            f"{float(length):.6g}: no bent arc-length curve has it (infeasible)"
         )
+
+
+def checked_length(length) -> Float[Array, ""]:
+    """The curve's length L as a traceable scalar; when concrete, `InvalidInputError` unless it
+    is finite and positive."""
+    length = jnp.asarray(length, dtype=float)
+    checked_shape(length, (), "length")
+    check_positive(length, "the length")
+    return length
+
+
+def checked_chord(chord, length) -> Float[Array, "3"]:
+    """The chord as a traceable (3,) array (`ShapeError` for another shape); when concrete,
+    `NonFiniteError` for NaN and `InfeasibleChordError` if |chord| ≥ length (no bent arc-length
+    curve of that length has it).  `length`: from `checked_length`."""
+    chord = jnp.asarray(chord, dtype=float)
+    checked_shape(chord, (3,), "chord")
+    _check_feasible_chord(chord, length, "chord")
     return chord
 
 
-def starting_array(x0, default, shape: tuple) -> np.ndarray:
-    """`x0` (copied, shape-checked) or the `default()` start."""
-    X0 = default() if x0 is None else np.array(x0, dtype=float)
-    if X0.shape != shape:
-        raise ShapeError(f"x0 must have shape {shape}, got {X0.shape}")
-    return X0
+def starting_array(x0, default, shape: tuple):
+    """`x0` (shape-checked) or the `default()` start, as an array `Problem` then copies."""
+    X0 = default() if x0 is None else x0
+    checked_shape(X0, shape, "x0")
+    return jnp.asarray(X0, dtype=float)
 
 
-def clamp_ends(X0: np.ndarray, first, last) -> tuple[np.ndarray, np.ndarray]:
-    """X0 with its first and last rows set to the clamps, and the `fixed` mask of those rows."""
-    X0 = X0.copy()
-    X0[0], X0[-1] = first, last
+def clamp_ends(X0, first, last) -> tuple[jax.Array, np.ndarray]:
+    """X0 with its first and last rows set to the clamps (traceable: the derivative with
+    respect to the clamps flows through these fixed entries), and the `fixed` mask of those rows."""
+    X0 = jnp.asarray(X0, dtype=float).at[0].set(first).at[-1].set(last)
     fixed = np.zeros(X0.shape, bool)
     fixed[[0, -1]] = True
     return X0, fixed
 
 
-def initial_tangents(n: int, length: float, chord, t_start, t_end) -> np.ndarray:
-    """A rough start: the great-circle interpolation of the end tangents, shifted by a constant
-    vector and renormalised so that its mean matches chord/length (a few fixed-point steps)."""
-    T = great_circle(np.asarray(t_start), np.asarray(t_end), np.linspace(0.0, 1.0, n))
-    target = np.asarray(chord) / length
-    shift = np.zeros(3)
-    for _ in range(50):
+def initial_tangents(n: int, length, chord, t_start, t_end, steps: int = 50):
+    """A rough start: the great-circle interpolation T of the end tangents, shifted by a
+    constant vector s and renormalised, `U = (T + s)/|T + s|`, with s from the fixed-point
+    iteration `s ← s + chord/length − mean(U)` (so that h Σ U ≈ chord).  No derivative
+    (`start_data`)."""
+    xp, (length, chord, t_start, t_end) = start_data(length, chord, t_start, t_end)
+    T = great_circle(t_start, t_end, xp.linspace(0.0, 1.0, n), xp)
+    target = chord / length
+
+    def shifted(shift):
         U = T + shift
-        U /= np.linalg.norm(U, axis=1, keepdims=True)
-        shift += target - U.mean(axis=0)
-    return U
+        return U / xp.linalg.norm(U, axis=1, keepdims=True)
+
+    shift = xp.zeros(3)
+    for _ in range(steps):
+        shift = shift + target - shifted(shift).mean(axis=0)
+    return shifted(shift)
 
 
 def clamped(
@@ -219,17 +270,23 @@ def clamped(
     with `clamp="edge"` (the unit multiplier of a clamped edge is undetermined: T_0 and
     T_{n−1} are fixed, so it has no equation) and m = n with `clamp="vertex"`.
 
+    Differentiable in `length`, `chord`, `t_start`, `t_end`: they enter `params` (h = L/n) and
+    the clamped rows of `x0` as traced values, so `jax.grad` of a function of
+    `solve(clamped(...))` with respect to them is the implicit derivative; the default start
+    carries no derivative (`start_data`).
+
     **Raises:** `InfeasibleChordError` if |chord| ≥ length (only the straight segment, or
-    nothing, is left); `InvalidInputError`/`ShapeError` for bad n, clamps or vectors;
-    `NonFiniteError` for NaN in `x0`.
+    nothing, is left); `InvalidInputError` for n < 3, a length that is not finite and positive,
+    zero or non-finite clamp tangents, an unknown clamp; `ShapeError` for vectors of the wrong
+    shape; `NonFiniteError` for NaN in `chord` or `x0`.  Values are checked when concrete
+    (also under `jax.grad`; not under `jit`/`vmap`).
     """
-    if int(n) < 3:
-        raise InvalidInputError(f"a clamped elastica needs at least 3 edges, got n = {n}")
+    n = checked_count(n, 3, "n, the number of edges of a clamped elastica,")
     if clamp not in ("edge", "vertex"):
         raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
+    length = checked_length(length)
     chord = checked_chord(chord, length)
-    t_start, t_end = _unit_vector(t_start, "t_start"), _unit_vector(t_end, "t_end")
-    n, h = int(n), float(length) / int(n)
+    t_start, t_end = unit_vector(t_start, "t_start"), unit_vector(t_end, "t_end")
     T0 = starting_array(x0, lambda: initial_tangents(n, length, chord, t_start, t_end), (n, 3))
     edges = np.arange(n)
     energy = dg.local_sum(_bend, np.stack([edges[:-1], edges[1:]], axis=1))
@@ -241,7 +298,7 @@ def clamped(
         energy = energy + dg.local_sum(_ghost_bend, np.array([[0], [n - 1]]), data=np.array([0, 1]))
         free_edges = edges
     constraints = unit_and_chord(free_edges, n)
-    params = {"h": h, "chord": jnp.asarray(chord), "t_start": jnp.asarray(t_start), "t_end": jnp.asarray(t_end)}
+    params = {"h": length / n, "chord": chord, "t_start": t_start, "t_end": t_end}
     return dg.Problem(
         energy, T0, constraints=constraints, params=params, fixed=fixed,
         name=f"clamped elastica (n={n}, clamp={clamp})",
@@ -251,13 +308,18 @@ def clamped(
 def closed(n: int, *, length: float = 1.0, x0) -> dg.Problem:
     """A closed discrete elastica (Remark 3.7): n unit tangents with Σ T_k = 0 and the bending
     energy summed over all n vertices.  Critical points include the regular n-gon (the minimum)
-    and Euler's figure-eight (a saddle).  Rotations act freely: the KKT matrix is singular."""
-    n, h = int(n), float(length) / int(n)
+    and Euler's figure-eight (a saddle).  Rotations act freely: the KKT matrix is singular.
+
+    **Raises:** `InvalidInputError` for n < 3 or a length that is not finite and positive,
+    `ShapeError` / `NonFiniteError` for `x0`.
+    """
+    n = checked_count(n, 3, "n, the number of edges of a closed elastica,")
+    length = checked_length(length)
     T0 = starting_array(x0, lambda: None, (n, 3))
     edges = np.arange(n)
     energy = dg.local_sum(_bend, np.stack([np.roll(edges, 1), edges], axis=1))
     constraints = unit_and_chord(edges, n)
-    params = {"h": h, "chord": jnp.zeros(3), "t_start": jnp.zeros(3), "t_end": jnp.zeros(3)}
+    params = {"h": length / n, "chord": jnp.zeros(3), "t_start": jnp.zeros(3), "t_end": jnp.zeros(3)}
     return dg.Problem(
         energy, T0, constraints=constraints, params=params,
         name=f"closed elastica (n={n})",

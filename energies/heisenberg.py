@@ -24,11 +24,12 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
-from ddgjax._checks import check_finite, is_concrete
-from ddgjax.errors import InvalidInputError, ShapeError
+from ddgjax._checks import check_finite, check_positive, checked_shape, when_concrete
+from ddgjax.errors import InvalidInputError, ShapeError, SingularVertexError
 
 __all__ = [
-    "hamiltonian", "flow", "tangent_flow_on_tangents", "ground_energy", "scaled_hamiltonian", "scaled_flow", "check_spins", "NonUnitSpinError",
+    "hamiltonian", "flow", "tangent_flow_on_tangents", "ground_energy", "scaled_hamiltonian", "scaled_flow", "check_spins", "check_neighbours",
+    "NonUnitSpinError",
 ]
 
 KINDS = ("naive", "integrable")
@@ -54,12 +55,17 @@ def integrable_energy(S: Float[Array, "n 3"], J) -> Float[Array, ""]:
 
 
 def check_spins(S, tol: float = 1e-10) -> None:
-    """Raise unless S is an (N, 3) array of finite unit spins, N ≥ 3 (names the spin)."""
-    if not is_concrete(S):
-        return
+    """Raise unless S is an (N, 3) array, N ≥ 3 (`ShapeError`, always), of finite unit spins
+    (`NonFiniteError` / `NonUnitSpinError` naming the spin, when S is concrete)."""
+    shape = np.shape(S)
+    if len(shape) != 2 or shape[1] != 3 or shape[0] < 3:
+        raise ShapeError(f"spins must be an (N, 3) array with N >= 3 on a closed chain, got shape {shape}")
+    _check_unit_spins(S, tol)
+
+
+@when_concrete
+def _check_unit_spins(S, tol: float) -> None:
     arr = np.asarray(S)
-    if arr.ndim != 2 or arr.shape[1] != 3 or arr.shape[0] < 3:
-        raise ShapeError(f"spins must be an (N, 3) array with N >= 3 on a closed chain, got shape {arr.shape}")
     check_finite(arr, "spins")
     defect = np.abs(np.linalg.norm(arr, axis=1) - 1.0)
     if np.any(defect > tol):
@@ -67,32 +73,73 @@ def check_spins(S, tol: float = 1e-10) -> None:
         raise NonUnitSpinError(f"spin {i} has length {np.linalg.norm(arr[i]):.15g}, not 1 (spins live on S²)")
 
 
+@when_concrete
+def check_neighbours(S) -> None:
+    """Raise `SingularVertexError` naming the first pair of neighbouring spins with
+    `1 + <S_i, S_{i+1}> <= dg.curves.SINGULAR_TOL` (anti-parallel): there the integrable
+    Hamiltonian `−2J log((1 + <S_i, S_{i+1}>)/2)` and its flow are singular (Remark A.1).
+    Concrete S only."""
+    arr = np.asarray(S, dtype=float)
+    gap = 1.0 + np.sum(arr * np.roll(arr, -1, axis=0), axis=1)
+    bad = np.flatnonzero(gap <= dg.curves.SINGULAR_TOL)
+    if bad.size:
+        i = int(bad[0])
+        j = (i + 1) % len(arr)
+        raise SingularVertexError(
+            f"spins {i} and {j} are anti-parallel (1 + <S_{i}, S_{j}> = {gap[i]:.3g}): the integrable "
+            "Hamiltonian −2J log((1 + <S_i, S_{i+1}>)/2) is singular there (Remark A.1)"
+        )
+
+
+def check_chain(S, kind: str) -> None:
+    """The checks of `check_spins`, and for the integrable chain those of `check_neighbours`."""
+    check_spins(S)
+    if kind == "integrable":
+        check_neighbours(S)
+
+
+@when_concrete
+def _check_coupling(J) -> None:
+    if not (np.isfinite(J) and J != 0):
+        raise InvalidInputError(f"the coupling J must be finite and non-zero (J = 0 is no interaction), got {J}")
+
+
+def checked_coupling(J) -> Float[Array, ""]:
+    """The coupling J as a traceable scalar (so `jax.grad` in J works); when concrete,
+    `InvalidInputError` unless it is finite and non-zero."""
+    J = jnp.asarray(J, dtype=float)
+    checked_shape(J, (), "the coupling J")
+    _check_coupling(J)
+    return J
+
+
 def hamiltonian(kind: str, J: float = 1.0) -> Callable:
     """`H(S)` of the naive or integrable closed chain (periodic, S_{N+1} = S_1, Sec A) with
-    coupling J ≠ 0.
+    coupling J ≠ 0 (traceable: `H` is differentiable in J).
 
-    **Raises:** `InvalidInputError` for an unknown kind, J = 0 or non-finite; when called on concrete spins,
-    `NonUnitSpinError` / `NonFiniteError` / `ShapeError` naming the spin.
+    **Raises:** `InvalidInputError` for an unknown kind, J = 0 or non-finite; when called on
+    concrete spins, `NonUnitSpinError` / `NonFiniteError` naming the spin, `SingularVertexError`
+    naming two anti-parallel neighbours (integrable chain); `ShapeError`.
     """
     if kind not in KINDS:
         raise InvalidInputError(f"kind must be one of {KINDS}, got {kind!r}")
-    if not (np.isfinite(J) and J != 0):
-        raise InvalidInputError(f"the coupling J must be finite and non-zero (J = 0 is no interaction), got {J}")
+    J = checked_coupling(J)
     energy = naive_energy if kind == "naive" else integrable_energy
 
     def H(S):
-        check_spins(S)
+        check_chain(S, kind)
         return energy(S, J)
 
     return H
 
 
 def flow(kind: str, J: float = 1.0) -> Callable:
-    """The equations of motion `∂_t S = ∇H × S` of `hamiltonian(kind, J)`, by autodiff."""
+    """The equations of motion `∂_t S = ∇H × S` of `hamiltonian(kind, J)`, by autodiff (the same
+    errors, raised before differentiating)."""
     f = dg.hamiltonian_flow(hamiltonian(kind, J), dg.spin_poisson)
 
     def checked(S):
-        check_spins(S)
+        check_chain(S, kind)
         return f(S)
 
     return checked
@@ -113,8 +160,10 @@ def ground_energy(kind: str, J: float, N: int) -> float:
 
 def scaled_hamiltonian(kind: str, J: float, eps: float) -> Callable:
     """`(H − H_aligned)/ε`: tends to `(J/2) ∫ |S'|² dx` for spins S_i = S(εi) (Sec A; the text's
-    "replacing H by H + N" for the naive chain)."""
+    "replacing H by H + N" for the naive chain).  **Raises:** as `hamiltonian`, and
+    `InvalidInputError` unless the spacing ε is finite and positive (when concrete)."""
     H = hamiltonian(kind, J)
+    check_positive(eps, "the spacing eps")
 
     def H_eps(S):
         return (H(S) - ground_energy(kind, J, S.shape[0])) / eps
@@ -125,4 +174,5 @@ def scaled_hamiltonian(kind: str, J: float, eps: float) -> Callable:
 def scaled_flow(kind: str, J: float, eps: float) -> Callable:
     """The flow of `H/ε` with time rescaled by 1/ε: tends to `∂_t S = J S × S''` (A.3)."""
     f = flow(kind, J)
+    check_positive(eps, "the spacing eps")
     return lambda S: f(S) / eps**2

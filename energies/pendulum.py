@@ -23,10 +23,10 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
-from ddgjax.errors import InvalidInputError
+from ddgjax._checks import check_finite, checked_count, checked_shape
 from solvers import solve
 
-from .elastica import bending_density, clamp_ends, great_circle, starting_array
+from .elastica import bending_density, clamp_ends, great_circle, start_data, starting_array, unit_vector
 
 __all__ = ["action", "step", "shoot", "kinetic"]
 
@@ -48,30 +48,34 @@ def _unit(T1, _):
     return jnp.dot(T1[0], T1[0]) - 1.0
 
 
-def _unit_vector(v, name: str) -> np.ndarray:
-    v = np.array(v, dtype=float)
-    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.linalg.norm(v) > 0:
-        raise InvalidInputError(f"{name} must be a finite non-zero vector of shape (3,), got {v}")
-    return v / np.linalg.norm(v)
-
-
 def action(n: int, *, a, T_first, T_last, x0=None) -> dg.Problem:
     """The action S of Def 3.3 over n tangents with T_0 = T_first and T_{n−1} = T_last fixed.
 
     Unknowns: `T` (n, 3); constraints `{"unit": |T_k|² − 1 for the free k}` (n − 2,).  The
-    default start is the great-circle interpolation of the end tangents.
+    default start is the great-circle interpolation of the end tangents.  Differentiable in the
+    gravity `a` (in `params`) and the end tangents (the fixed rows of `x0`).
+
+    **Raises:** `InvalidInputError` for n < 3 or end tangents that are zero or not finite,
+    `NonFiniteError` for NaN in `a` or `x0`, `ShapeError` (values are checked when concrete).
     """
-    if int(n) < 3:
-        raise InvalidInputError(f"the pendulum needs at least 3 tangents, got n = {n}")
-    n = int(n)
-    first, last = _unit_vector(T_first, "T_first"), _unit_vector(T_last, "T_last")
-    T0, fixed = clamp_ends(starting_array(x0, lambda: great_circle(first, last, np.linspace(0.0, 1.0, n)), (n, 3)), first, last)
+    n = checked_count(n, 3, "n, the number of tangents of the pendulum,")
+    a = jnp.asarray(a, dtype=float)
+    checked_shape(a, (3,), "a")
+    check_finite(a, "a")
+    first, last = unit_vector(T_first, "T_first"), unit_vector(T_last, "T_last")
+    T0, fixed = clamp_ends(starting_array(x0, lambda: _great_circle_start(first, last, n), (n, 3)), first, last)
     k = np.arange(n)
     energy = dg.local_sum(_kinetic_term, np.stack([k[:-1], k[1:]], axis=1)) + dg.local_sum(_potential_term, k[:, None])
     return dg.Problem(
-        energy, T0, constraints=dg.concat(unit=dg.local_map(_unit, k[1:-1, None])), params={"a": jnp.asarray(a, dtype=float)},
+        energy, T0, constraints=dg.concat(unit=dg.local_map(_unit, k[1:-1, None])), params={"a": a},
         fixed=fixed, name=f"discrete spherical pendulum (n={n})",
     )
+
+
+def _great_circle_start(first, last, n: int):
+    """The great-circle interpolation of the end tangents, with no derivative (`start_data`)."""
+    xp, (first, last) = start_data(first, last)
+    return great_circle(first, last, xp.linspace(0.0, 1.0, n), xp)
 
 
 def _tangent_basis(T):
@@ -103,18 +107,22 @@ def step(T_prev: Float[Array, "3"], T_curr: Float[Array, "3"], a: Float[Array, "
     Solved by the generic solver as the constraint set of a problem with zero energy (three
     equations, three unknowns), started from the linear extrapolation 2T_k − T_{k−1}.
 
-    **Raises:** `ConvergenceError` if no T_{k+1} exists nearby (e.g. too large a gravity).
+    **Raises:** `ConvergenceError` if no T_{k+1} exists nearby (e.g. too large a gravity);
+    `ShapeError` unless the three vectors have shape (3,); `NonFiniteError` for NaN.
     """
-    T_prev, T_curr = jnp.asarray(T_prev, dtype=float), jnp.asarray(T_curr, dtype=float)
+    T_prev, T_curr, a = (jnp.asarray(v, dtype=float) for v in (T_prev, T_curr, a))
+    for v, name in ((T_prev, "T_prev"), (T_curr, "T_curr"), (a, "a")):
+        checked_shape(v, (3,), name)
     guess = 2.0 * T_curr - T_prev
     guess = guess / jnp.linalg.norm(guess)
-    params = {"T_prev": T_prev, "T_curr": T_curr, "a": jnp.asarray(a, dtype=float)}
+    params = {"T_prev": T_prev, "T_curr": T_curr, "a": a}
     problem = dg.Problem(_no_energy, guess, constraints=_lagrangian_map_equations, params=params, name="pendulum step")
     return solve(problem, tol=tol).x
 
 
 def shoot(T_first, T_second, a, n: int) -> Float[Array, "n 3"]:
     """The pendulum trajectory T_0 … T_{n−1} from its first two tangents by iterating `step`."""
+    n = checked_count(n, 2, "n, the number of tangents of the trajectory,")
     T = [jnp.asarray(T_first, dtype=float), jnp.asarray(T_second, dtype=float)]
     for _ in range(n - 2):
         T.append(step(T[-2], T[-1], a))

@@ -34,13 +34,17 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 import numpy as np
+from jaxtyping import Array, Float
 
 import ddgjax as dg
 from ddgjax import frames
 from ddgjax import quaternion as qt
+from ddgjax._checks import check_finite, checked_count, checked_shape, when_concrete
 from ddgjax.errors import InvalidInputError
 
-from .elastica import bending_density, checked_chord, clamp_ends, starting_array, unit_and_chord
+from .elastica import (
+    bending_density, checked_chord, checked_length, clamp_ends, start_data, starting_array, unit_and_chord,
+)
 
 __all__ = ["clamped", "tangents", "twist_angles", "curve", "load", "ClampMismatchError"]
 
@@ -78,15 +82,28 @@ def _chord(Phi1, share, p):
     return share * p["chord"] - p["h"] * qt.rotate(Phi1[0], E1)
 
 
-def _interpolated_frames(q0: np.ndarray, q1: np.ndarray, n: int) -> np.ndarray:
-    """Normalised linear interpolation of two unit quaternions (signs aligned): a start."""
-    q1 = q1 if q0 @ q1 >= 0 else -q1
-    s = np.linspace(0.0, 1.0, n)[:, None]
+def _interpolated_frames(q0, q1, n: int):
+    """Normalised linear interpolation of two unit quaternions (signs aligned): a start, with no
+    derivative (`elastica.start_data`)."""
+    xp, (q0, q1) = start_data(q0, q1)
+    q1 = xp.where(q0 @ q1 >= 0, q1, -q1)
+    s = xp.linspace(0.0, 1.0, n)[:, None]
     Q = (1 - s) * q0 + s * q1
-    return Q / np.linalg.norm(Q, axis=1, keepdims=True)
+    return Q / xp.linalg.norm(Q, axis=1, keepdims=True)
 
 
-def _check_tangent(frame: np.ndarray, t, name: str) -> None:
+def checked_frame(q, name: str) -> Float[Array, "4"]:
+    """An end frame as a traceable (4,) array; when concrete, `NonFiniteError` for NaN and
+    `InvalidInputError` unless it is a unit quaternion (naming it)."""
+    q = jnp.asarray(q, dtype=float)
+    checked_shape(q, (4,), name)
+    check_finite(q, name)
+    when_concrete(qt.check_unit)(q, name)
+    return q
+
+
+@when_concrete
+def _check_tangent(frame, t, name: str) -> None:
     """Raise `ClampMismatchError` if the tangent of `frame` is not the prescribed unit vector t."""
     if t is None:
         return
@@ -98,6 +115,16 @@ def _check_tangent(frame: np.ndarray, t, name: str) -> None:
         raise ClampMismatchError(
             f"frame_{name} has the tangent Φ i Φ⁻¹ = {np.round(T, 12).tolist()}, which disagrees with "
             f"t_{name} = {t.tolist()} (end {'0' if name == 'start' else 'n−1'} of the rod)"
+        )
+
+
+@when_concrete
+def _check_stiffness(alpha) -> None:
+    """Raise `InvalidInputError` unless the twist stiffness α is finite and positive."""
+    if not (np.isfinite(alpha) and alpha > 0):
+        raise InvalidInputError(
+            f"the twist stiffness alpha must be positive (the reference requires α ≠ 0; α = 0 leaves "
+            f"the frames' twist undetermined), got {alpha}"
         )
 
 
@@ -122,26 +149,25 @@ def clamped(
     tangents, checked against the frames.  Constraints `{"unit": (m,), "chord": (3,)}` with
     one unit entry per free frame (m = n − 2 for `clamp="edge"`, n for `"vertex"`).
 
-    **Raises:** `InfeasibleChordError` (|chord| ≥ length), `InvalidInputError` (α ≤ 0, n < 3,
-    non-unit frames, unknown clamp), `ClampMismatchError` (a frame's tangent is not the given
-    end tangent), `ShapeError`.
+    Differentiable in `alpha`, `length`, `chord` and the end frames (traced values in `params`
+    and the clamped rows of `x0`, as for `elastica.clamped`).
+
+    **Raises:** `InfeasibleChordError` (|chord| ≥ length), `InvalidInputError` (α ≤ 0 or not
+    finite, n < 3, a length that is not finite and positive, non-unit frames, unknown clamp),
+    `NonFiniteError` (NaN in a frame or the chord), `ClampMismatchError` (a frame's tangent is
+    not the given end tangent), `ShapeError`.  Values are checked when concrete.
     """
-    if int(n) < 3:
-        raise InvalidInputError(f"a clamped rod needs at least 3 edges, got n = {n}")
+    n = checked_count(n, 3, "n, the number of edges of a clamped rod,")
     if clamp not in ("edge", "vertex"):
         raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
-    if not (np.isfinite(alpha) and alpha > 0):
-        raise InvalidInputError(
-            f"the twist stiffness alpha must be positive (the reference requires α ≠ 0; α = 0 leaves "
-            f"the frames' twist undetermined), got {alpha}"
-        )
+    alpha = jnp.asarray(alpha, dtype=float)
+    checked_shape(alpha, (), "alpha")
+    _check_stiffness(alpha)
+    length = checked_length(length)
     chord = checked_chord(chord, length)
-    qt.check_unit(frame_start, "frame_start")
-    qt.check_unit(frame_end, "frame_end")
-    q0, q1 = np.asarray(frame_start, dtype=float), np.asarray(frame_end, dtype=float)
+    q0, q1 = checked_frame(frame_start, "frame_start"), checked_frame(frame_end, "frame_end")
     _check_tangent(q0, t_start, "start")
     _check_tangent(q1, t_end, "end")
-    n, h = int(n), float(length) / int(n)
     Phi0 = starting_array(x0, lambda: _interpolated_frames(q0, q1, n), (n, 4))
     edges = np.arange(n)
     energy = dg.local_sum(_vertex_energy, np.stack([edges[:-1], edges[1:]], axis=1))
@@ -152,10 +178,7 @@ def clamped(
         energy = energy + dg.local_sum(_ghost_vertex_energy, np.array([[0], [n - 1]]), data=np.array([0, 1]))
         fixed, free_edges = np.zeros((n, 4), bool), edges
     constraints = unit_and_chord(free_edges, n, _unit, _chord)
-    params = {
-        "h": h, "alpha": jnp.asarray(float(alpha)), "chord": jnp.asarray(chord),
-        "frame_start": jnp.asarray(q0), "frame_end": jnp.asarray(q1),
-    }
+    params = {"h": length / n, "alpha": alpha, "chord": chord, "frame_start": q0, "frame_end": q1}
     return dg.Problem(
         energy, Phi0, constraints=constraints, params=params, fixed=fixed, name=f"clamped rod (n={n}, clamp={clamp})"
     )

@@ -22,7 +22,7 @@ def test_bad_input_is_one_line_with_hint_and_exit_code_2():
     assert run.returncode == 2
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in run.stderr
-    assert lines[0].startswith("ddgjax: error: ") and "n = -3" in lines[0] and "(hint: " in lines[0]
+    assert lines[0].startswith("ddgjax: error: ") and "must be at least 3, got -3" in lines[0] and "(hint: " in lines[0]
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -38,8 +38,53 @@ def test_errors_in_process(argv, message, capsys):
     assert err.count("\n") == 0 and message in err and "(hint: " in err
 
 
+def _bad_files(tmp_path):
+    """A regular file, a 25-byte OFF header asking for 3·10⁹ vertices, an OBJ with the index 0,
+    and a closed surface (the octahedron), in tmp_path."""
+    from ddgjax import mesh
+
+    (tmp_path / "file").write_text("x")
+    (tmp_path / "huge.off").write_bytes(b"OFF\n3000000000 1 0\n0 0 0\n")
+    (tmp_path / "bad.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")
+    mesh.write(tmp_path / "closed.off", *mesh.octahedron())
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["verify", "--jobs", "0"], "verify: argument --jobs: must be a positive integer, got '0'"),
+    (["verify", "--jobs", "-3"], "must be a positive integer, got '-3'"),
+    (["verify", "--only", "sec4", "--out", "/proc/x"], "cannot write in the directory /proc/x"),
+    (["verify", "--only", "sec4", "--out", "{tmp}/file/report"], "{tmp}/file is not a directory"),
+    (["solve", "elastica", "--n", "8", "--plot", "/proc/x/e.png"], "cannot write in the directory /proc/x"),
+    (["solve", "elastica", "--n", "8", "--plot", "{tmp}/e.xyz"], "unknown format '.xyz'"),
+    (["solve", "elastica", "--n", "8", "--plot", "{tmp}"], "it is a directory"),
+    (["solve", "minimal-surface", "--mesh", "{tmp}/missing.obj"], "{tmp}/missing.obj: no such file"),
+    (["solve", "minimal-surface", "--mesh", "{tmp}/huge.off"], "promises 3000000000 vertices and 1 faces"),
+    (["solve", "minimal-surface", "--mesh", "{tmp}/bad.obj"], "line 4: the face corner '0' refers to no vertex"),
+    (["solve", "minimal-surface", "--mesh", "{tmp}/closed.off"], "is closed: a minimal surface spans a boundary"),
+    (["solve", "no-such-object"], "invalid choice: 'no-such-object'"),
+    ([], "the following arguments are required: command"),
+])
+def test_bad_paths_files_and_arguments_are_one_line_and_exit_code_2(tmp_path, capsys, argv, message):
+    """Unwritable outputs, missing or malformed mesh files, bad arguments: exit code 2 and one
+    line on stderr with a hint, before any work is done (nothing on stdout)."""
+    _bad_files(tmp_path)
+    assert cli.main([a.format(tmp=tmp_path) for a in argv]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("ddgjax: error: ") and message.format(tmp=tmp_path) in err and "(hint: " in err
+
+
+def test_a_hostile_mesh_file_is_one_line_in_a_real_process(tmp_path):
+    """The 25-byte OFF header asking for 3·10⁹ vertices (67 GiB, once): exit code 2, one line."""
+    _bad_files(tmp_path)
+    run = subprocess.run([sys.executable, "-m", "ddgjax", "solve", "minimal-surface", "--mesh", str(tmp_path / "huge.off")],
+                         cwd=ROOT, capture_output=True, text=True, timeout=120)
+    lines = run.stderr.strip().splitlines()
+    assert run.returncode == 2 and len(lines) == 1 and "promises 3000000000 vertices" in lines[0], run.stderr
+
+
 def test_debug_shows_the_exception():
-    with pytest.raises(InvalidInputError, match="n = 2"):
+    with pytest.raises(InvalidInputError, match="must be at least 3, got 2"):
         cli.main(["--debug", "solve", "elastica", "--n", "2"])
 
 
