@@ -14,7 +14,10 @@ curvatures are signed, positive for a left turn (κ_± with N = iT, Section 1.3)
 edges the "arclength" kind is (1.1) exactly.  The vertex tangent and the flows use the unit
 tangents T_k = Δγ_k / ε of an arc-length curve with edges of length ε (Section 1.2), so the
 vertex tangent tends to γ' and the Heisenberg flow, with time rescaled t → εt/2, to T' × T
-(Remark 2.3).
+(Remark 2.3).  Every core works on γ / s for a power of two s (`ddgjax.mesh.lengths.normalised`:
+exact, and s = 1 at ordinary sizes) and scales its result back (lengths by s, curvatures by
+1/s), so tangents, turning angles and curvatures are right for coordinates from 1e-300 to 1e300
+(|Δγ|² would leave float64 beyond about 1e±154).
 
 **The flows are derived, not typed in.**  `tangent_flow` and `heisenberg_flow` are the
 gradients of the local bending energy E_k = log 2 − log(1 + <T_k, T_{k−1}>) (Remark 3.6),
@@ -35,8 +38,9 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ._checks import is_concrete
+from ._checks import check_positive, is_concrete
 from .errors import ArcLengthError, InvalidInputError, NonFiniteError, ShapeError, SingularVertexError
+from .mesh.lengths import normalised
 
 __all__ = [
     "edge_vectors",
@@ -96,12 +100,13 @@ def _vertex_index(j: int, closed: bool) -> int:
     return j if closed else j + 1
 
 
-def _zero_edge_message(lengths: np.ndarray, closed: bool) -> str | None:
-    zero = np.flatnonzero(lengths == 0)
+def _zero_edge_message(E: np.ndarray, closed: bool) -> str | None:
+    """Which successive vertices coincide (an edge vector E_k that is exactly 0), or None."""
+    zero = np.flatnonzero(np.all(E == 0, axis=1))
     if not zero.size:
         return None
     k = int(zero[0])
-    n_vertices = len(lengths) + (0 if closed else 1)
+    n_vertices = len(E) + (0 if closed else 1)
     return f"vertices {k} and {(k + 1) % n_vertices} coincide (edge {k} has length 0)"
 
 
@@ -122,13 +127,12 @@ def _validate(gamma, closed: bool, *, arc_length: bool = False, singular: str | 
     gamma = _as_curve(gamma, closed)
     if not is_concrete(gamma):
         return gamma
-    E = np.asarray(_edges(gamma, closed))
-    lengths = np.linalg.norm(E, axis=1)
-    if message := _zero_edge_message(lengths, closed):
+    if message := _zero_edge_message(np.asarray(_edges(gamma, closed)), closed):
         raise SingularVertexError(f"{message}: the tangent T_k (Def 1.2) is undefined")
     if arc_length:
         check_arc_length(gamma, closed=closed)
-    if singular and (message := _antiparallel_message(*_vertex_pairs(E / lengths[:, None], closed), closed)):
+    if singular and (message := _antiparallel_message(*_vertex_pairs(np.asarray(_unit_tangents(gamma, closed)), closed),
+                                                      closed)):
         raise SingularVertexError(f"{message}, where {singular} divides by 1 + <T_k, T_k-1> = 0")
     return gamma
 
@@ -136,7 +140,7 @@ def _validate(gamma, closed: bool, *, arc_length: bool = False, singular: str | 
 def _irregularity(gamma, closed: bool) -> str | None:
     """Why `gamma` is not regular (Def 1.2: any three successive points differ), or None."""
     E = np.asarray(edge_vectors(gamma, closed))
-    if message := _zero_edge_message(np.linalg.norm(E, axis=1), closed):
+    if message := _zero_edge_message(E, closed):
         return message
     E_prev, E_next = _vertex_pairs(E, closed)
     back = np.flatnonzero(~np.any(E_prev + E_next != 0, axis=1))  # γ_{k+1} − γ_{k−1} = 0
@@ -161,6 +165,9 @@ def check_regular(gamma: Curve, closed: bool = False) -> None:
 
 
 def _arc_length_defect(gamma, length, tol: float, closed: bool) -> str | None:
+    check_positive(tol, "tol")
+    if length is not None:
+        check_positive(length, "length")
     lengths = np.asarray(edge_lengths(gamma, closed))
     reference = float(np.median(lengths)) if length is None else float(length)
     bad = np.flatnonzero(~(np.abs(lengths - reference) <= tol * reference))
@@ -176,7 +183,8 @@ def is_arc_length(
 ) -> bool:
     """True when every edge has length `length` (default: the median edge length) up to the
     relative tolerance `tol`: a discrete arc-length curve (Def 1.2), with edges of length
-    ε = `length` (Section 1.2).  Concrete input only."""
+    ε = `length` (Section 1.2).  Concrete input only.  **Raises:** `InvalidInputError` unless
+    `tol` (and `length`, if given) is finite and positive."""
     return _arc_length_defect(gamma, length, tol, closed) is None
 
 
@@ -184,7 +192,8 @@ def check_arc_length(
     gamma: Curve, length: float | None = None, tol: float = ARC_LENGTH_TOL, closed: bool = False
 ) -> None:
     """Raise `ArcLengthError` naming the first edge whose length differs from `length` (default:
-    the median edge length) by more than `tol·length` (Def 1.2).  Concrete input only."""
+    the median edge length) by more than `tol·length` (Def 1.2).  Concrete input only; raises
+    `InvalidInputError` as `is_arc_length`."""
     if message := _arc_length_defect(gamma, length, tol, closed):
         raise ArcLengthError(f"gamma is not arc-length parametrised (Def 1.2): {message}")
 
@@ -223,14 +232,21 @@ def _edges(gamma: Array, closed: bool) -> Array:
     return ends - gamma[: len(ends)]
 
 
+def _normalised_lengths(gamma: Array, closed: bool) -> tuple[Array, Array]:
+    """`(|Δγ_k| / s, s)`: the edge lengths of γ / s (`ddgjax.mesh.lengths.normalised`)."""
+    gamma, s = normalised(gamma)
+    return _norm(_edges(gamma, closed)), s
+
+
 @_jit
 def _lengths(gamma: Array, closed: bool) -> Array:
-    return _norm(_edges(gamma, closed))
+    lengths, s = _normalised_lengths(gamma, closed)
+    return lengths * s
 
 
 @_jit
 def _unit_tangents(gamma: Array, closed: bool) -> Array:
-    E = _edges(gamma, closed)
+    E = _edges(normalised(gamma)[0], closed)
     return E / _norm(E)[:, None]
 
 
@@ -298,8 +314,9 @@ def _vertex_curvature(gamma: Array, closed: bool) -> Array:
     """Def 1.4: `κ_k = 2 sin φ_k / |γ_{k+1} − γ_{k−1}|`, the inverse radius of the circle through
     γ_{k−1}, γ_k, γ_{k+1}.  Equals 2 sin(φ_k/2) ≤ 2 for unit edges (Remark 1.4)."""
     sin, _ = _sin_cos(gamma, closed)
+    gamma, s = normalised(gamma)
     E_prev, E_next = _vertex_pairs(_edges(gamma, closed), closed)
-    return 2 * sin / _norm(E_prev + E_next)
+    return 2 * sin / _norm(E_prev + E_next) / s
 
 
 @_jit
@@ -307,18 +324,19 @@ def _edge_curvature(gamma: Array, closed: bool) -> Array:
     """Def 1.5: `κ_k = (tan(φ_k/2) + tan(φ_{k+1}/2)) / |Δγ_k|` at edge k, the inverse radius of
     the oriented circle touching the lines of the edges k − 1, k, k + 1."""
     half = _half_angle_tangents(gamma, closed)
-    lengths = _lengths(gamma, closed)
+    lengths, s = _normalised_lengths(gamma, closed)
     if closed:
-        return (half + jnp.roll(half, -1)) / lengths
-    return (half[:-1] + half[1:]) / lengths[1:-1]
+        return (half + jnp.roll(half, -1)) / lengths / s
+    return (half[:-1] + half[1:]) / lengths[1:-1] / s
 
 
 @_jit
 def _arclength_curvature(gamma: Array, closed: bool) -> Array:
     """Def 1.6, (1.1): `κ_k = 2 tan(φ_k/2) / ε`, the inverse radius of the circle touching the
     edges k − 1 and k at their midpoints (ε = 1 gives (1.1)); ε is the mean of the two lengths."""
-    length_prev, length_next = _vertex_pairs(_lengths(gamma, closed), closed)
-    return 4 * _half_angle_tangents(gamma, closed) / (length_prev + length_next)
+    lengths, s = _normalised_lengths(gamma, closed)
+    length_prev, length_next = _vertex_pairs(lengths, closed)
+    return 4 * _half_angle_tangents(gamma, closed) / (length_prev + length_next) / s
 
 
 def _checked_vertex(gamma, closed: bool) -> Array:
@@ -425,8 +443,9 @@ def vertex_tangent(gamma: Curve, closed: bool = False) -> Curve:
 
 
 def _flow_pairs(gamma: Array, closed: bool) -> tuple[Array, Array]:
-    """`(T_{k−1}, T_k)` with `T_k = Δγ_k / ε`, ε the mean edge length: unit on arc-length curves."""
-    E = _edges(gamma, closed)
+    """`(T_{k−1}, T_k)` with `T_k = Δγ_k / ε`, ε the mean edge length: unit on arc-length curves
+    (computed on γ / s, scale-invariant)."""
+    E = _edges(normalised(gamma)[0], closed)
     return _vertex_pairs(E / jnp.mean(_norm(E)), closed)
 
 

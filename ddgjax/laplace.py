@@ -22,6 +22,11 @@ The same derivation serves every Laplacian of ddgjax: here composed with the squ
 of a mesh (V, F); in `ddgjax.intrinsic` with the lengths of an intrinsic triangulation (after
 edge flips: the Laplace–Beltrami operator).  The autodiff Hessian is jit-compiled (XLA fuses it
 into one pass over the faces).
+
+**Scale.**  The cotan weights of a triangle mesh are invariant under V ↦ sV (in 2-D the Dirichlet
+energy is), areas scale by s².  The positions are divided by a power of two first
+(`mesh.lengths.normalised`, exact, and 1 at ordinary sizes), so that nothing overflows or
+underflows for coordinates of any size; areas are scaled back (`mesh.lengths.scaled_back`).
 """
 
 from __future__ import annotations
@@ -34,15 +39,17 @@ import scipy.sparse as sp
 from jaxtyping import Array, Float, Int
 
 from .errors import (
-    DegenerateFaceError,
     InvalidInputError,
     NonFiniteError,
     ShapeError,
 )
 from .mesh.connectivity import boundary_indices, checked_triangles, from_faces
 from .mesh.lengths import (
+    check_face_areas,
     corner_weights,
     dirichlet_energy,
+    normalised,
+    scaled_back,
     squared_side_lengths,
     stiffness,
     triangle_area,
@@ -64,15 +71,11 @@ __all__ = [
     "triangle_stiffness",
 ]
 
-# A face is degenerate when |e1 × e2|² ≤ DEGENERATE |e1|²|e2|², i.e. the sine of its angle at
-# corner 0 is below ~1e-7: there the cotangents are round-off.
-DEGENERATE = 1e-14
-
-
 def triangle_dirichlet_energy(f: Float[Array, "3"], P: Float[Array, "3 n"]) -> Float[Array, ""]:
     """Dirichlet energy ½ ∫ |∇f|² dA of the affine interpolant of the values f on the triangle P
-    (Sec 6.3): `ddgjax.mesh.lengths.dirichlet_energy` of its squared side lengths."""
-    return dirichlet_energy(f, squared_side_lengths(P))
+    (Sec 6.3): `ddgjax.mesh.lengths.dirichlet_energy` of its squared side lengths, those of
+    P / s (`normalised`; the energy is scale-invariant)."""
+    return dirichlet_energy(f, squared_side_lengths(normalised(P)[0]))
 
 
 @jax.jit
@@ -125,11 +128,12 @@ def triangle_stiffness(V, F) -> np.ndarray:
 
 
 def _per_face(kernel, V, F) -> tuple[np.ndarray, np.ndarray]:
-    """`(kernel's per-face output, F)` for a validated mesh whose faces all have non-zero area."""
+    """`(kernel's per-face output, F)` for a validated mesh whose faces all have non-zero area;
+    the kernel's output must be invariant under V ↦ sV (it sees V / s, `normalised`)."""
     V, F = checked_triangle_mesh(V, F)
-    out, sin2 = kernel(V, F)
+    out, sin2 = kernel(normalised(V)[0], F)
     out, sin2 = np.asarray(out), np.asarray(sin2)
-    _check_areas(sin2, F)
+    check_face_areas(sin2, F)
     return out, F
 
 
@@ -137,16 +141,6 @@ def check_nondegenerate(V, F) -> None:
     """Raise `DegenerateFaceError` naming the first face of zero area (sin of its angle at
     corner 0 below ~1e-7), after the checks of `checked_triangle_mesh`."""
     _per_face(_corner_weights_of_positions, V, F)
-
-
-def _check_areas(sin2, F) -> None:
-    bad = np.flatnonzero(~(sin2 > DEGENERATE))
-    if bad.size:
-        f = int(bad[0])
-        raise DegenerateFaceError(
-            f"face {f} {F[f].tolist()} has zero area (sin² of its angle {sin2[f]:.1e}): its cotangents "
-            "are undefined; remove or repair degenerate triangles"
-        )
 
 
 def _corner_weights(V, F) -> tuple[np.ndarray, np.ndarray]:
@@ -309,10 +303,15 @@ def checked_graph(edges, weights, n_vertices=None) -> tuple[np.ndarray, np.ndarr
 
 
 def face_areas(V, F) -> np.ndarray:
-    """(nf,) A(F) of each triangle from its side lengths (Kahan's Heron, `mesh.lengths`)."""
+    """(nf,) A(F) of each triangle from its side lengths (Kahan's Heron, `mesh.lengths`), those
+    of V / s scaled back by s².
+
+    **Raises:** as `checked_triangle_mesh`, and `InvalidInputError` where an area is not a
+    float64 (`mesh.lengths.scaled_back`: coordinates beyond ~1e±154)."""
     V, F = checked_triangle_mesh(V, F)
+    V, s = normalised(V)
     L = np.sqrt(squared_side_lengths(V[F]))
-    return triangle_area(L[:, 0], L[:, 1], L[:, 2])
+    return scaled_back(triangle_area(L[:, 0], L[:, 1], L[:, 2]), s, 2, "a face area")
 
 
 def barycentric_areas(V, F) -> np.ndarray:

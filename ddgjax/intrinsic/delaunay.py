@@ -25,7 +25,13 @@ Ties: an edge counts as non-Delaunay only if cot α + cot β < −tol · s with 
 the cotangent sums of its two triangles (Lemma 7.17; the rounding error of a cotangent computed
 from lengths is about eps · s), so that the two diagonals of a (numerically) cocircular
 quadrilateral are not flipped back and forth; the flipped edge of a genuinely non-Delaunay edge
-is Delaunay (Lemma 7.11).
+is Delaunay (Lemma 7.11).  `tol` must be finite and positive (`InvalidInputError` otherwise).
+
+Scale: the angle test, the harmonic index and the flips are invariant under l ↦ s l (a flip
+scales the new diagonal by s).  The loop runs on the lengths divided by a power of two
+(`ddgjax.mesh.lengths.normalised`: exact, and 1 at ordinary sizes), so that the squares and
+areas it forms stay in float64 for lengths from 1e-300 to 1e300, and the flipped lengths are
+scaled back.
 """
 
 from __future__ import annotations
@@ -34,10 +40,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._checks import check_positive
 from ..errors import FlipBudgetError, InvalidInputError
 from ..mesh.lengths import (
     face_harmonic_index,
     padded_size,
+    power_of_two_scale,
     side_cotangent_columns,
     side_cotangents,
     triangle_area,
@@ -46,8 +54,8 @@ from .triangulation import (
     Triangulation,
     cotan_weights,
     from_faces,
+    normalised_side_lengths,
     of_arrays,
-    side_lengths,
 )
 
 __all__ = [
@@ -87,8 +95,9 @@ def _interior(tri: Triangulation) -> np.ndarray:
 def _face_geometry(tri: Triangulation):
     """(cot, s): per halfedge the cot of the angle opposite it (3 nf,), derived from the
     Dirichlet energy (`ddgjax.mesh.lengths.side_cotangents`); per face
-    s = cot α + cot β + cot γ = (a² + b² + c²)/4A = h(Δ)/4 (nf,) (Lemma 7.17)."""
-    L = side_lengths(tri)
+    s = cot α + cot β + cot γ = (a² + b² + c²)/4A = h(Δ)/4 (nf,) (Lemma 7.17); from the
+    normalised lengths (both are scale-invariant)."""
+    L = normalised_side_lengths(tri)
     cots = side_cotangents(L * L)[0]
     return cots.reshape(-1), cots.sum(axis=1)
 
@@ -102,6 +111,7 @@ def edge_cotangent_sums(tri: Triangulation) -> np.ndarray:
 def _non_delaunay(tri: Triangulation, tol: float) -> np.ndarray:
     """(ne,) bool: the interior edges between two distinct triangles that fail the angle test
     (one vectorised pass over the faces)."""
+    check_positive(tol, "tol")
     cots, scales = _face_geometry(tri)
     scale = np.bincount(tri.edge, np.repeat(scales, 3), minlength=tri.n_edges)
     bad = np.bincount(tri.edge, cots, minlength=tri.n_edges) < -tol * scale
@@ -113,20 +123,22 @@ def _non_delaunay(tri: Triangulation, tol: float) -> np.ndarray:
 
 def delaunay_edges(tri: Triangulation, tol: float = DELAUNAY_TOL) -> np.ndarray:
     """(ne,) bool: the angle criterion of Prop 7.9 for each edge (boundary edges count as
-    Delaunay; an edge lying twice on one triangle always is)."""
+    Delaunay; an edge lying twice on one triangle always is).  **Raises:** `InvalidInputError`
+    unless `tol` is finite and positive."""
     return ~_non_delaunay(tri, tol)
 
 
 def is_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL) -> bool:
     """True iff every edge satisfies the angle criterion (Prop 7.9, Thm 7.7).  `F` is a
     `Triangulation`, a `FlipResult` or faces (nf, 3) with `lengths` ordered like
-    `ddgjax.mesh.edges(F)`."""
+    `ddgjax.mesh.edges(F)`.  **Raises:** as `delaunay_edges`."""
     return bool(delaunay_edges(as_triangulation(F, lengths), tol).all())
 
 
 def harmonic_index(F, lengths=None) -> float:
-    """h(T) = Σ_Δ (a² + b² + c²) / A(Δ) (Def 7.7)."""
-    L = side_lengths(as_triangulation(F, lengths))
+    """h(T) = Σ_Δ (a² + b² + c²) / A(Δ) (Def 7.7); scale-invariant, from the normalised
+    lengths."""
+    L = normalised_side_lengths(as_triangulation(F, lengths))
     a, b, c = L.T
     return float(np.sum(face_harmonic_index(a, b, c, triangle_area(a, b, c))))
 
@@ -182,8 +194,9 @@ def flip_to_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL, max_flips: i
 
     **Returns:** a `FlipResult`.
 
-    **Raises:** the errors of `triangulation.from_faces`; `FlipBudgetError` when the budget is
-    used up (naming an edge that is still not Delaunay).
+    **Raises:** the errors of `triangulation.from_faces`; `InvalidInputError` unless `tol` is
+    finite and positive; `FlipBudgetError` when the budget is used up (naming an edge that is
+    still not Delaunay).
     """
     return flip_owned(as_triangulation(F, lengths), tol, max_flips, record_history, copy=True)
 
@@ -191,23 +204,33 @@ def flip_to_delaunay(F, lengths=None, *, tol: float = DELAUNAY_TOL, max_flips: i
 def flip_owned(tri: Triangulation, tol: float = DELAUNAY_TOL, max_flips: int | None = None,
                record_history: bool = False, copy: bool = False) -> FlipResult:
     """`flip_to_delaunay` of a triangulation whose arrays the caller owns: with `copy=False` they
-    are flipped in place (and `tri` must not be used afterwards)."""
+    are flipped in place (and `tri` must not be used afterwards).  The loop runs on the lengths
+    divided by the power of two s nearest the longest (module docstring), multiplied by s again
+    at the end (exactly: s is a power of two)."""
     # numba is loaded here, not at `import ddgjax`; the loop is compiled once per machine
     from .flip_algorithm import flip_algorithm, interleaved, squared_sides
 
+    check_positive(tol, "tol")
     budget = 50 * tri.n_faces + 1000 if max_flips is None else int(max_flips)
     arrays = tuple(np.ascontiguousarray(a) for a in (tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths))
     if copy:
         arrays = tuple(a.copy() for a in arrays)
+    lengths = arrays[3]
+    s = float(power_of_two_scale(lengths.max())) if lengths.size else 1.0
+    if s != 1.0:
+        lengths *= 1.0 / s
     n_flips, n_rounds, steps, stuck, h0, key = flip_algorithm(*arrays, float(tol), budget, bool(record_history))
+    # the derived cotangents of the result (the loop's keys hold the law of cosines)
+    by_side = None if stuck >= 0 else side_cotangent_columns(
+        squared_sides(arrays[1], lengths, padded_size(tri.n_faces)), tri.n_faces)
+    if s != 1.0:
+        lengths *= s
     if stuck >= 0:
         raise FlipBudgetError(
             f"flip budget of {budget} flips used up; edge {stuck} is still not Delaunay (raise "
             "max_flips, or check the lengths for near-degenerate triangles)"
         )
     out = of_arrays(*arrays, tri.n_vertices) if n_flips else tri
-    # the derived cotangents of the result (the loop's keys hold the law of cosines)
-    by_side = side_cotangent_columns(squared_sides(arrays[1], arrays[3], padded_size(tri.n_faces)), tri.n_faces)
     cots = interleaved(*by_side, key)  # into the buffer of the loop's keys
     if record_history:
         history = h0 + np.concatenate([[0.0], np.cumsum(steps)])

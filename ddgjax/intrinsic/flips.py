@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import MeshError
-from ..mesh.lengths import triangle_area
+from ..errors import InvalidInputError, MeshError
+from ..mesh.lengths import normalised, triangle_area
 from .geometry import apex, flipped_length
 from .triangulation import Triangulation, of_arrays
 
@@ -76,16 +76,23 @@ def is_flippable(tri: Triangulation, e: int, margin: float = 1e-9) -> bool:
     """Lemma 5.8: e is interior, its two triangles are distinct, and their unfolding a d b c is a
     strictly convex quadrilateral, i.e. the diagonal cd crosses ab strictly between a and b, at
     least `margin` · l_ab away from both (so that the new triangles are not degenerate).
+    Scale-invariant: the quadrilateral is unfolded from its lengths divided by a power of two
+    (`ddgjax.mesh.lengths.normalised`).
+
+    **Raises:** `InvalidInputError` unless 0 ≤ margin < ½.
     """
+    if not 0.0 <= margin < 0.5:
+        raise InvalidInputError(f"margin must be a number in [0, 0.5), got {margin!r}")
     h, t = tri.halfedges[e]
     if t < 0 or h // 3 == t // 3:
         return False
-    _, _, (l_ab, l_bc, l_ca, l_ad, l_db) = quad(tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths, np.array([e]))
+    _, _, ls = quad(tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths, np.array([e]))
+    l_ab, l_bc, l_ca, l_ad, l_db = normalised(np.concatenate(ls))[0]
     A1, A2 = triangle_area(l_ab, l_bc, l_ca), triangle_area(l_ab, l_ad, l_db)
     (xc, yc), (xd, yd) = apex(l_ab, l_ca, l_bc, A1, 1.0), apex(l_ab, l_ad, l_db, A2, -1.0)
     # the diagonal cd crosses the x-axis strictly between a = 0 and b = l_ab
     x_cross = xd + (xc - xd) * (-yd) / (yc - yd)
-    return bool(margin * l_ab[0] < x_cross[0] < (1 - margin) * l_ab[0])
+    return bool(margin * l_ab < x_cross < (1 - margin) * l_ab)
 
 
 def flip(tri: Triangulation, e: int) -> Triangulation:

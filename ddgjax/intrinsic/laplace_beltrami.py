@@ -29,6 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from .._checks import check_positive
 from ..errors import DDGError
 from ..laplace import laplacian_of_edge_weights
 from ..mesh.lengths import face_harmonic_index, triangle_area
@@ -47,7 +48,7 @@ from .triangulation import (
     from_checked_mesh,
     from_mesh,
     next_halfedge,
-    side_lengths,
+    normalised_side_lengths,
 )
 
 __all__ = [
@@ -86,8 +87,12 @@ def _delaunay_laplacian(tri: Triangulation, tol: float, labels=None, owned: bool
 def laplace_beltrami_from_lengths(F, lengths=None, *, tol: float = DELAUNAY_TOL) -> sp.csr_matrix:
     """Def 7.8 for a piecewise flat surface given by faces and edge lengths (ordered like
     `ddgjax.mesh.edges(F)`) or by a `Triangulation`: the cotan Laplacian of its intrinsic
-    Delaunay triangulation.
+    Delaunay triangulation.  Invariant under l ↦ s l (2-D cotan weights).
+
+    **Raises:** the errors of `triangulation.from_faces`; `InvalidInputError` unless `tol` is
+    finite and positive.
     """
+    check_positive(tol, "tol")
     return _delaunay_laplacian(as_triangulation(F, lengths), tol)
 
 
@@ -99,10 +104,13 @@ def laplace_beltrami(V, F, *, tol: float = DELAUNAY_TOL) -> sp.csr_matrix:
     spatially coherent is renumbered internally along a Morton curve (`ordering`, for cache
     locality); the result is in the caller's labels.
 
+    Invariant under V ↦ sV (2-D cotan weights; lengths from V / s, `triangulation.from_mesh`).
+
     **Raises:** the errors of `triangulation.from_mesh` (bad faces, non-manifold edges,
     inconsistent orientation, degenerate triangles, NaN coordinates), naming the caller's
-    indices.
+    indices; `InvalidInputError` unless `tol` is finite and positive.
     """
+    check_positive(tol, "tol")
     V = checked_positions(V)
     F, _ = checked_faces(F, V.shape[0])
     if is_local(F, V.shape[0]):
@@ -137,9 +145,12 @@ class Tessellation:
 def delaunay_tessellation(tri: Triangulation, *, zero_tol: float = 1e-9) -> Tessellation:
     """Merge the triangles of the Delaunay triangulation `tri` across the interior edges with
     |cot α + cot β| ≤ zero_tol · (h(Δ₁) + h(Δ₂))/4 (zero weight up to rounding, the scale of
-    `delaunay`'s tie test) into cocircular polygons (Remark 7.7, Fig 7.20).
+    `delaunay`'s tie test) into cocircular polygons (Remark 7.7, Fig 7.20); scale-invariant.
+
+    **Raises:** `InvalidInputError` unless `zero_tol` is finite and positive.
     """
-    L = side_lengths(tri)
+    check_positive(zero_tol, "zero_tol")
+    L = normalised_side_lengths(tri)
     a, b, c = L.T
     per_face = 0.25 * face_harmonic_index(a, b, c, triangle_area(a, b, c))
     scale = np.bincount(tri.edge, np.repeat(per_face, 3), minlength=tri.n_edges)

@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import check_positive
+from ..mesh.lengths import normalised
+
 __all__ = ["circularity", "diagonal_values", "dirichlet_energy_difference", "is_circular", "quadrilateral"]
 
 
@@ -51,6 +54,10 @@ def circularity(r):
 
 def is_circular(r, rtol: float = 1e-12) -> bool:
     """Lemma 7.15: the vertices of Q lie on a circle iff r₁r₃ = r₂r₄ (the intersecting chords
-    theorem), tested to the relative tolerance `rtol`."""
-    r1, r2, r3, r4 = r
+    theorem), tested to the relative tolerance `rtol`, on r divided by a power of two
+    (`ddgjax.mesh.lengths.normalised`; the test is scale-invariant).
+
+    **Raises:** `InvalidInputError` unless `rtol` is finite and positive."""
+    check_positive(rtol, "rtol")
+    r1, r2, r3, r4 = normalised(np.asarray(r, dtype=np.float64))[0]
     return bool(abs(circularity(r)) <= rtol * max(r1 * r3, r2 * r4))

@@ -17,6 +17,10 @@ opposite directions.  Arrays:
 - `lengths` (ne,) float: the edge lengths.
 
 The angle at corner k of a face lies opposite its side k + 1.
+
+Angles, cotangents and the Delaunay test are invariant under l ↦ s l; they are computed on the
+lengths divided by a power of two (`ddgjax.mesh.lengths.normalised`: exact, and 1 at ordinary
+sizes), so that squares and areas stay within float64 for lengths from 1e-300 to 1e300.
 """
 
 from __future__ import annotations
@@ -40,7 +44,13 @@ from ..mesh.connectivity import (
     next_halfedge,
 )
 from ..mesh.lengths import angle_defects as angle_defects_of_sides
-from ..mesh.lengths import corner_angles_of_sides, side_cotangents, triangle_area
+from ..mesh.lengths import (
+    check_edge_lengths,
+    corner_angles_of_sides,
+    normalised,
+    side_cotangents,
+    triangle_area,
+)
 from ..mesh.lengths import corner_cotangents as cotangents_of_sides
 from .geometry import apex
 
@@ -60,6 +70,7 @@ __all__ = [
     "from_gluing",
     "from_mesh",
     "next_halfedge",
+    "normalised_side_lengths",
     "opposite_side_lengths",
     "side_lengths",
     "unfold",
@@ -134,12 +145,7 @@ def _check_lengths(tri: Triangulation) -> None:
     l = tri.lengths
     if l.shape != (tri.n_edges,):
         raise ShapeError(f"lengths must have shape ({tri.n_edges},) (one per edge), got {l.shape}")
-    bad = np.flatnonzero(~np.isfinite(l))
-    if bad.size:
-        raise NonFiniteError(f"edge {bad[0]} has the non-finite length {l[bad[0]]}")
-    bad = np.flatnonzero(l <= 0)
-    if bad.size:
-        raise TriangleInequalityError(f"edge {bad[0]} has the non-positive length {l[bad[0]]}")
+    check_edge_lengths(l)
     L = side_lengths(tri)
     a, b, c = L[:, 0], L[:, 1], L[:, 2]
     longest = np.maximum(np.maximum(a, b), c)
@@ -174,6 +180,12 @@ def from_faces(F, lengths, n_vertices: int | None = None) -> Triangulation:
     return _validated(Triangulation(connectivity, np.array(lengths, dtype=np.float64)))
 
 
+def normalised_side_lengths(tri: Triangulation) -> np.ndarray:
+    """`side_lengths` divided by the power of two nearest the longest (`ddgjax.mesh.lengths.
+    normalised`), for the scale-invariant quantities."""
+    return normalised(side_lengths(tri))[0]
+
+
 def checked_positions(V) -> np.ndarray:
     """V as an (nv, n) float64 array; `NonFiniteError` naming the first vertex with NaN / inf."""
     V = np.asarray(V, dtype=np.float64)
@@ -195,12 +207,16 @@ def from_mesh(V, F) -> Triangulation:
 
 
 def from_checked_mesh(V: np.ndarray, F: np.ndarray) -> Triangulation:
-    """`from_mesh` for V, F already passed through `checked_positions` / `checked_triangles`."""
+    """`from_mesh` for V, F already passed through `checked_positions` / `checked_triangles`;
+    the lengths of V / s times s (`ddgjax.mesh.lengths.normalised`), so that |v_j − v_i|² need
+    not be a float."""
     nv = V.shape[0]
     connectivity, keys = glue_triangles(F, nv)
+    V, s = normalised(V)
     lo = keys // nv
     d = np.take(V, keys - lo * nv, axis=0) - np.take(V, lo, axis=0)  # take: fancy row indexing is slow
-    return _validated(Triangulation(connectivity, np.sqrt(np.einsum("ij,ij->i", d, d))))
+    lengths = np.sqrt(np.einsum("ij,ij->i", d, d))
+    return _validated(Triangulation(connectivity, lengths if s == 1.0 else lengths * s))
 
 
 def from_gluing(twin, side_lengths) -> Triangulation:
@@ -240,8 +256,9 @@ def opposite_side_lengths(tri: Triangulation) -> np.ndarray:
 
 
 def corner_cotangents(tri: Triangulation) -> np.ndarray:
-    """(nf, 3): cot of the angle at corner k (`ddgjax.mesh.lengths.corner_cotangents`)."""
-    L = opposite_side_lengths(tri)
+    """(nf, 3): cot of the angle at corner k (`ddgjax.mesh.lengths.corner_cotangents`), from
+    the normalised lengths (scale-invariant)."""
+    L = normalised(opposite_side_lengths(tri))[0]
     a, b, c = L[:, 0], L[:, 1], L[:, 2]
     return np.stack(cotangents_of_sides(a * a, b * b, c * c, triangle_area(a, b, c)), axis=1)
 
@@ -249,8 +266,9 @@ def corner_cotangents(tri: Triangulation) -> np.ndarray:
 def halfedge_cotangents(tri: Triangulation) -> np.ndarray:
     """(3 nf,): cot of the angle opposite each halfedge (side i of a face is opposite its corner
     i + 2), derived as twice the off-diagonal of the Hessian of the Dirichlet energy on the
-    squared lengths (`ddgjax.mesh.lengths.side_cotangents`, Thm 6.6)."""
-    L = side_lengths(tri)
+    squared lengths (`ddgjax.mesh.lengths.side_cotangents`, Thm 6.6), of the normalised
+    lengths (scale-invariant)."""
+    L = normalised_side_lengths(tri)
     return side_cotangents(L * L)[0].reshape(-1)
 
 
@@ -296,14 +314,16 @@ def unfold(tri: Triangulation, e: int) -> np.ndarray:
     a, b, c, d with e = ab from a = (0, 0) to b = (l_ab, 0), the face of the first halfedge
     (a, b, c) above and the other face (b, a, d) below the x-axis.
 
-    **Raises:** `MeshError` for a boundary edge (naming it).
+    **Raises:** `MeshError` for a boundary edge (naming it).  Laid out on the lengths divided by
+    a power of two s and scaled back (`ddgjax.mesh.lengths.normalised`).
     """
     h, t = (int(x) for x in tri.halfedges[e])
     if t < 0:
         raise MeshError(f"edge {e} is a boundary edge: it has one triangle, nothing to unfold")
     h1, t1 = next_halfedge(h), next_halfedge(t)
-    l_ab, l_bc, l_ca, l_ad, l_db = tri.lengths[[e, tri.edge[h1], tri.edge[next_halfedge(h1)],
-                                                tri.edge[t1], tri.edge[next_halfedge(t1)]]]
+    l, s = normalised(tri.lengths[[e, tri.edge[h1], tri.edge[next_halfedge(h1)],
+                                   tri.edge[t1], tri.edge[next_halfedge(t1)]]])
+    l_ab, l_bc, l_ca, l_ad, l_db = l
     c = apex(l_ab, l_ca, l_bc, triangle_area(l_ab, l_bc, l_ca), +1.0)
     d = apex(l_ab, l_ad, l_db, triangle_area(l_ab, l_ad, l_db), -1.0)
-    return np.array([[0.0, 0.0], [l_ab, 0.0], c, d])
+    return np.array([[0.0, 0.0], [l_ab, 0.0], c, d]) * s

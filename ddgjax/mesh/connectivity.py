@@ -43,6 +43,7 @@ __all__ = [
     "as_halfedges",
     "boundary_indices",
     "boundary_vertices",
+    "check_has_faces",
     "edges",
     "faces_as_corners",
     "from_faces",
@@ -319,13 +320,21 @@ def from_faces(F, n_vertices: int | None = None) -> Halfedges:
     return h
 
 
+def check_has_faces(n_faces: int) -> None:
+    """Raise `MeshError` for a face list without faces: the empty set is not a surface (Def
+    4.1), and its invariants (χ = 0 would read as a torus) describe nothing."""
+    if n_faces == 0:
+        raise MeshError("F has no faces: a surface needs at least one face (Def 4.1)")
+
+
 def checked_triangles(F, n_vertices: int | None = None) -> tuple[np.ndarray, int]:
     """`(F, nv)`: F as an (nf, 3) int64 array of labels < nv (default max + 1), no face repeating
-    a vertex.  **Raises:** `ShapeError` (not (nf, 3)) or `MeshError` (a non-integer, negative or
-    too large index, a repeated vertex), naming the face."""
+    a vertex.  **Raises:** `ShapeError` (not (nf, 3)) or `MeshError` (no faces, a non-integer,
+    negative or too large index, a repeated vertex), naming the face."""
     F = np.asarray(F)
     if F.ndim != 2 or F.shape[1] != 3:
         raise ShapeError(f"F must be an (nf, 3) array of triangles, got shape {F.shape}")
+    check_has_faces(F.shape[0])
     if F.size and not np.issubdtype(F.dtype, np.integer) and not np.all(F == np.round(F)):
         f = int(np.argwhere(F != np.round(F))[0, 0])
         raise MeshError(f"face {f} has a non-integer vertex index {F[f].tolist()}")

@@ -5,6 +5,18 @@ The geometry is jnp and differentiable in `V`; for an (nf, k) array everything i
 `jax.jit(angle_defect)(V, F)` works with a traced `F`, and functions of `V` alone
 (`jax.jit(lambda V: edge_mean_curvature(V, F))`) close over a concrete `F` whose connectivity is
 built (and validated) once, at trace time.
+
+**Scale.**  Angles, angle defects and dihedral angles are invariant under V ↦ sV, edge mean
+curvature scales by s and areas by s².  Every kernel works on V / s for a power of two s
+(`lengths.normalised`: exact, and s = 1 at ordinary sizes) and scales its result back
+(`lengths.scaled_back`), so the answers are right for coordinates from 1e-300 to 1e300, or an
+error says which result is not a float64.
+
+**Validation** (of concrete input): NaN / inf coordinates (`NonFiniteError` naming the index);
+coincident vertices of an edge, where the angles are undefined (`SingularVertexError` naming the
+vertices, the edge and a face); faces of zero area up to round-off, where the normal is undefined,
+in the functions that use normals (`DegenerateFaceError` naming the face).  A collinear triangle
+whose vertices are distinct has the angles 0, 0, π (the limit), so angle defects are defined there.
 """
 
 from __future__ import annotations
@@ -15,11 +27,17 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import is_concrete
-from ..errors import MeshError, OrientationError, ShapeError
-from .connectivity import Halfedges, faces_as_corners, from_faces
+from .._checks import check_finite, check_positive, is_concrete
+from ..errors import MeshError, OrientationError, ShapeError, SingularVertexError
+from .connectivity import Halfedges, check_has_faces, faces_as_corners, from_faces
+from .lengths import (
+    check_face_areas,
+    defect_from_angles,
+    normalised,
+    scaled_back,
+    squared_side_lengths,
+)
 from .lengths import corner_angles as angles_from_sides
-from .lengths import defect_from_angles, squared_side_lengths
 
 __all__ = [
     "corner_angles",
@@ -46,20 +64,65 @@ def _corners(F):
     return jnp.asarray(vertex), nxt, prv
 
 
-def _validate(V, F):
-    """Shape checks, and for a concrete `F` its connectivity (manifold, indices, no unused
-    vertex), returned as `Halfedges`; None for a traced `F`.
-    """
+def _check_positions(V) -> None:
+    """Shape (nv, 3), and finite coordinates when V is concrete (`NonFiniteError`)."""
     if len(jnp.shape(V)) != 2 or jnp.shape(V)[1] != 3:
         raise ShapeError(f"V must have shape (nv, 3), got {jnp.shape(V)}")
+    check_finite(V, "V")
+
+
+def _validate(V, F):
+    """Shape checks, finite coordinates, and for a concrete `F` its connectivity (at least one
+    face, manifold, indices, no unused vertex, no edge of length 0 when V is concrete), returned
+    as `Halfedges`; None for a traced `F`.
+    """
+    _check_positions(V)
     if not is_concrete(F):
         return None
     nv = jnp.shape(V)[0]
     h = from_faces(F if not hasattr(F, "shape") else np.asarray(F), n_vertices=nv)
+    check_has_faces(h.n_faces)
     unused = np.flatnonzero(np.bincount(h.vertex, minlength=nv) == 0)
     if unused.size:
         raise MeshError(f"vertex {unused[0]} lies in no face; remove unused vertices first")
+    _check_distinct_ends(V, h)
     return h
+
+
+def _check_distinct_ends(V, h: Halfedges) -> None:
+    """`SingularVertexError` naming the first edge whose two vertices have equal coordinates
+    (concrete V): the angles at its ends, and the normals of its faces, are undefined."""
+    if not is_concrete(V):
+        return
+    V, E = np.asarray(V), h.edges
+    same = np.flatnonzero(np.all(V[E[:, 0]] == V[E[:, 1]], axis=1))
+    if same.size:
+        e = int(same[0])
+        raise SingularVertexError(
+            f"vertices {E[e, 0]} and {E[e, 1]} coincide (edge {e} of face {h.face[h.halfedges[e, 0]]} "
+            "has length 0): the angles at them are undefined; weld or move them"
+        )
+
+
+def _first_corners(F):
+    """(v_0, v_1, v_{k−1}) of each face, as int arrays."""
+    if hasattr(F, "shape"):
+        F = np.asarray(F)
+        return F[:, 0], F[:, 1], F[:, -1]
+    return tuple(np.array([f[i] for f in F], dtype=np.int64) for i in (0, 1, -1))
+
+
+def _check_areas(V, F, N) -> None:
+    """`DegenerateFaceError` (`lengths.check_face_areas`) naming the first face of zero area up
+    to round-off: (2A / |e₁|²)(2A / |e₂|²) ≤ DEGENERATE, A = |N| the area of the face (the norm
+    of its area vector N) and e₁, e₂ its sides at corner 0 (for a triangle, sin² of the angle
+    there).  V and N of one scale (concrete; nothing is checked for traced values)."""
+    if not is_concrete((V, N)):
+        return
+    V, two_area = np.asarray(V), 2.0 * np.linalg.norm(np.asarray(N), axis=1)
+    v0, v1, vk = _first_corners(F)
+    e1, e2 = V[v1] - V[v0], V[vk] - V[v0]
+    check_face_areas((two_area / np.einsum("ij,ij->i", e1, e1)) * (two_area / np.einsum("ij,ij->i", e2, e2)), F)
 
 
 def boundary_vertex_mask(h: Halfedges) -> np.ndarray:
@@ -78,9 +141,11 @@ def _is_triangle_array(F) -> bool:
 
 @partial(jax.jit, static_argnames="triangles")
 def _angles_at_corners(V, vertex, nxt, prv, triangles: bool):
-    """Flat corner angles.  `triangles` (corners of an (nf, 3) array): from the side lengths
-    alone (`lengths.corner_angles`, Thm 5.5); polygons, whose angles the side lengths do not
+    """Flat corner angles of V / s (`lengths.normalised`; angles are scale-invariant).
+    `triangles` (corners of an (nf, 3) array): from the side lengths alone
+    (`lengths.corner_angles`, Thm 5.5); polygons, whose angles the side lengths do not
     determine: ∠(v_next − v, v_prev − v)."""
+    V = normalised(V)[0]
     if triangles:
         L = jnp.sqrt(squared_side_lengths(V[vertex.reshape(-1, 3)]))
         return angles_from_sides(L).reshape(-1)
@@ -93,7 +158,7 @@ def corner_angles(V, F):
     lengths |v_j − v_i| (`lengths.corner_angles`), for polygons α = ∠(v_next − v, v_prev − v).
 
     **Returns:** (nf, k) for an (nf, k) array `F`, else (n_corners,) in the order of the faces.
-    **Raises:** as `angle_defect`.
+    **Raises:** as `angle_defect`; scale-invariant (module docstring).
     """
     _validate(V, F)
     angles = _angles_at_corners(jnp.asarray(V), *_corners(F), triangles=_is_triangle_array(F))
@@ -118,9 +183,12 @@ def angle_defect(V, F):
         K(p) = 2π − Σ_i α_i  at an interior vertex,   φ(p) = π − Σ_i α_i  at a boundary vertex,
 
     so that Σ_p = 2πχ for every (possibly bounded, possibly non-orientable) surface (Thm 5.6).
+    Scale-invariant (module docstring).
 
-    **Raises:** `ShapeError` for V not (nv, 3); for concrete `F`, `MeshError` /
-    `NonManifoldError` for bad faces (see `connectivity.from_faces`) and for a vertex in no face.
+    **Raises:** `ShapeError` for V not (nv, 3); `NonFiniteError` for NaN / inf coordinates; for
+    concrete `F`, `MeshError` / `NonManifoldError` for bad faces (see `connectivity.from_faces`)
+    and for a vertex in no face, and `SingularVertexError` naming two vertices of an edge that
+    coincide.
     """
     h = _validate(V, F)
     vertex, nxt, prv = _corners(F)
@@ -137,19 +205,34 @@ def _angle_defect_kernel(V, vertex, nxt, prv, boundary, triangles: bool):
 def vertex_kind(V, F, atol: float = 1e-12):
     """+1 elliptic (K > atol), 0 flat (|K| ≤ atol), −1 hyperbolic (K < −atol) per vertex (Def 5.2);
     boundary vertices are classified by their turning angle.
+
+    **Raises:** `InvalidInputError` unless atol is finite and positive; as `angle_defect`.
     """
+    check_positive(atol, "atol")
     K = angle_defect(V, F)
     return jnp.where(K > atol, 1, jnp.where(K < -atol, -1, 0))
 
 
 def face_area_vectors(V, F):
     """(nf, 3): ½ Σ_i v_i × v_{i+1} over each face (Newell); its norm is the area of a planar
-    face and its direction the normal given by the face's orientation.
+    face and its direction the normal given by the face's orientation.  Computed on V / s and
+    scaled back by s² (module docstring).
+
+    **Raises:** `ShapeError`, `NonFiniteError` (coordinates); `InvalidInputError` where an entry
+    is not a float64 at this scale (`lengths.scaled_back`).
     """
+    _check_positions(V)
+    N, s = _normalised_area_vectors(V, F)
+    return scaled_back(N, s, 2, "a face area vector")
+
+
+def _normalised_area_vectors(V, F):
+    """`(N, s)`: the area vectors of the faces of V / s, s = `lengths.normalised(V)[1]`."""
+    V, s = normalised(jnp.asarray(V))
     vertex, nxt, _ = _corners(F)
     face = np.repeat(np.arange(jnp.shape(F)[0]), jnp.shape(F)[1]) if hasattr(F, "shape") else faces_as_corners(F)[1]
     n_faces = int(face.max()) + 1 if face.size else 0
-    return _area_vectors(jnp.asarray(V), vertex, nxt, face, n_faces)
+    return _area_vectors(V, vertex, nxt, face, n_faces), s
 
 
 @partial(jax.jit, static_argnums=4)
@@ -159,8 +242,13 @@ def _area_vectors(V, vertex, nxt, face, n_faces):
 
 
 def surface_area(V, F):
-    """A(S) = Σ_f |face area vector| (planar faces)."""
-    return jnp.sum(jnp.linalg.norm(face_area_vectors(V, F), axis=-1))
+    """A(S) = Σ_f |face area vector| (planar faces); scales by s² (module docstring).
+
+    **Raises:** as `face_area_vectors`.
+    """
+    _check_positions(V)
+    N, s = _normalised_area_vectors(V, F)
+    return scaled_back(jnp.sum(jnp.linalg.norm(N, axis=-1)), s, 2, "the surface area")
 
 
 def _interior_pairs(F, nv):
@@ -191,20 +279,26 @@ def dihedral_angles(V, F):
         θ(e) = atan2(⟨d, N₁ × N₂⟩, ⟨N₁, N₂⟩),
 
     the angle turning N₁ into N₂.  It is positive at convex edges of an outward-oriented surface
-    (θ = π/2 on the cube) and negative at concave ones; θ = 0 on boundary edges.
+    (θ = π/2 on the cube) and negative at concave ones; θ = 0 on boundary edges.  Scale-invariant
+    (module docstring).
 
-    **Raises:** `OrientationError` if two faces traverse an edge in the same direction.
+    **Raises:** `OrientationError` if two faces traverse an edge in the same direction; as
+    `angle_defect`; `DegenerateFaceError` naming a face of zero area (its normal is undefined).
     """
     return _dihedral_angles_and_edges(V, F)[0]
 
 
 def _dihedral_angles_and_edges(V, F):
+    """`(θ, edges, V / s, s)` (`lengths.normalised`)."""
     checked = _validate(V, F)
     h, h1, h2 = _interior_pairs(F if checked is None else checked, jnp.shape(V)[0])
     inner = h2 >= 0
     f1, f2 = h.face[h1], h.face[np.where(inner, h2, h1)]
-    theta = _signed_dihedral(face_area_vectors(V, F), jnp.asarray(V), h.vertex[h1], h.head[h1], f1, f2)
-    return jnp.where(jnp.asarray(inner), theta, 0.0), h.edges
+    N, s = _normalised_area_vectors(V, F)
+    V = jnp.asarray(V) * (1.0 / s)
+    _check_areas(V, F, N)
+    theta = _signed_dihedral(N, V, h.vertex[h1], h.head[h1], f1, f2)
+    return jnp.where(jnp.asarray(inner), theta, 0.0), h.edges, V, s
 
 
 @jax.jit
@@ -218,10 +312,19 @@ def _signed_dihedral(N, V, tail, head, f1, f2):
 
 def edge_mean_curvature(V, F):
     """H(e) = ½ θ(e) l(e) per edge, ordered like `edges(F)` (Def 5.3); θ as in `dihedral_angles`
-    (positive at convex edges of an outward-oriented surface, 0 on the boundary).
+    (positive at convex edges of an outward-oriented surface, 0 on the boundary).  Scales by s
+    (a mean curvature 1/s integrated over an area s²; module docstring).
+
+    **Raises:** as `dihedral_angles`; `InvalidInputError` where H(e) is not a float64.
     """
-    theta, E = _dihedral_angles_and_edges(V, F)
-    return _half_angle_times_length(theta, jnp.asarray(V), E)
+    H, s = _normalised_edge_mean_curvature(V, F)
+    return scaled_back(H, s, 1, "an edge mean curvature")
+
+
+def _normalised_edge_mean_curvature(V, F):
+    """`(H, s)`: the edge mean curvatures of V / s."""
+    theta, E, V, s = _dihedral_angles_and_edges(V, F)
+    return _half_angle_times_length(theta, V, E), s
 
 
 @jax.jit
@@ -230,13 +333,19 @@ def _half_angle_times_length(theta, V, E):
 
 
 def total_mean_curvature(V, F):
-    """H(S) = Σ_e H(e) = ½ Σ_e θ(e) l(e) (Def 5.3)."""
-    return jnp.sum(edge_mean_curvature(V, F))
+    """H(S) = Σ_e H(e) = ½ Σ_e θ(e) l(e) (Def 5.3); scales by s.  **Raises:** as
+    `edge_mean_curvature`."""
+    H, s = _normalised_edge_mean_curvature(V, F)
+    return scaled_back(jnp.sum(H), s, 1, "the total mean curvature")
 
 
 def steiner_area(V, F, rho):
     """A(S_ρ) = A(S) + 2 H(S) ρ + K(S) ρ², K(S) = Σ_p K(p) = 2πχ (Thm 5.7 for convex polyhedra,
-    where K(S) = 4π; Remark 5.5 for closed polyhedral surfaces with signed pieces).
+    where K(S) = 4π; Remark 5.5 for closed polyhedral surfaces with signed pieces).  Evaluated
+    on V / s and ρ / s and scaled back by s².  **Raises:** as `edge_mean_curvature`.
     """
     K = jnp.sum(angle_defect(V, F))
-    return surface_area(V, F) + 2 * total_mean_curvature(V, F) * rho + K * rho**2
+    H, s = _normalised_edge_mean_curvature(V, F)
+    A = jnp.sum(jnp.linalg.norm(_normalised_area_vectors(V, F)[0], axis=-1))
+    r = rho * (1.0 / s)
+    return scaled_back(A + 2 * jnp.sum(H) * r + K * r**2, s, 2, "the area of the parallel surface")

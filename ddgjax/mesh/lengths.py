@@ -12,6 +12,13 @@ side opposite corner k, i.e. of the edge (F[f, k+1], F[f, k+2]) (indices mod 3).
 The scalar functions (`triangle_area`, `corner_cotangents`, `face_harmonic_index`) take numpy or
 jax arrays and stay in that library: the flip loop calls them on numpy arrays, the autodiff
 kernels on traced ones.
+
+**Scale.**  Angles, cotangents and the Dirichlet energy are invariant under l ↦ s l, areas scale
+by s² (Thm 5.5 holds for every s > 0), but the squares and the fourth powers inside Heron's
+formula leave float64 beyond s ≈ 1e±77.  So the functions here bring their lengths to ordinary
+size by a power of two (`power_of_two_scale`: exact in floating point, and 1 for lengths of
+ordinary size, where nothing changes), compute there, and scale a covariant result back
+(`scaled_back`, which raises where the result itself does not fit in float64).
 """
 
 from __future__ import annotations
@@ -22,12 +29,22 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .._checks import is_concrete
-from ..errors import ShapeError, TriangleInequalityError
+from ..errors import (
+    DegenerateFaceError,
+    InvalidInputError,
+    NonFiniteError,
+    ShapeError,
+    TriangleInequalityError,
+)
 from .connectivity import from_faces
 
 __all__ = [
+    "DEGENERATE",
     "angle_defect_from_lengths",
     "angle_defects",
+    "check_edge_lengths",
+    "check_face_areas",
+    "check_triangle_inequalities",
     "corner_angles",
     "corner_angles_from_lengths",
     "corner_angles_of_sides",
@@ -38,7 +55,10 @@ __all__ = [
     "edge_lengths",
     "face_harmonic_index",
     "face_side_lengths",
+    "normalised",
     "padded_size",
+    "power_of_two_scale",
+    "scaled_back",
     "side_cotangent_columns",
     "side_cotangents",
     "squared_side_lengths",
@@ -50,6 +70,95 @@ __all__ = [
 def _xp(*arrays):
     """jax.numpy if any argument is a jax array (or tracer), else numpy."""
     return jnp if any(isinstance(a, jax.Array) for a in arrays) else np
+
+
+_SCALE_STEP = 128  # scales are 2^(128 k): lengths within 2^±64 stay as they are
+_SCALE_LIMIT = 7  # |128 k| ≤ 896: the scale and its inverse are normal floats
+
+
+def power_of_two_scale(m):
+    """The power of two 2^(128 k) nearest to m > 0 (elementwise; numpy or jax): m / 2^(128 k)
+    lies within 2^±65 (for m within 2^±960), so that squares and fourth powers of lengths of
+    that size are ordinary floats, and dividing by it is exact.  It is 1 for m of ordinary size
+    (within 2^±64), for m = 0 and for non-finite m.  Constant for autodiff (a scale is piecewise
+    constant, and the functions normalised by it do not depend on it)."""
+    xp = _xp(m)
+    if xp is jnp:
+        m = jax.lax.stop_gradient(m)
+    k = xp.clip(xp.rint(xp.frexp(m)[1] / _SCALE_STEP), -_SCALE_LIMIT, _SCALE_LIMIT)
+    return xp.ldexp(xp.ones_like(m, dtype=float), (_SCALE_STEP * k).astype(xp.int32))
+
+
+def normalised(X):
+    """`(X / s, s)`: the array X (numpy or jax) divided by the power of two s =
+    `power_of_two_scale(max |X|)` (exact)."""
+    xp = _xp(X)
+    s = power_of_two_scale(xp.max(xp.abs(X)) if X.size else xp.asarray(0.0))
+    if xp is np and s == 1.0:
+        return X, s
+    return X * (1.0 / s), s
+
+
+def scaled_back(x, s, power: int, what: str):
+    """x · s^power: a result computed on lengths divided by s, returned to the caller's scale
+    (as `power` multiplications, so that s^power itself need not be a float).
+
+    **Raises:** `InvalidInputError` when x is concrete and a finite non-zero entry leaves the
+    normal float64 range there (it overflows, or underflows to a subnormal or 0): `what` at this
+    scale is not a float64.  Traced values are returned as they are (inf or 0 there).
+    """
+    out = x
+    with np.errstate(over="ignore", under="ignore"):
+        for _ in range(abs(power)):
+            out = out * s if power > 0 else out / s
+    if not (is_concrete((x, s)) and np.any(np.asarray(s) != 1.0)):
+        return out
+    x_, out_ = np.asarray(x), np.asarray(out)
+    finite = np.isfinite(x_) & (x_ != 0)
+    bad = finite & ~(np.isfinite(out_) & (np.abs(out_) >= np.finfo(np.float64).tiny))
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0]) if x_.ndim else ()
+        where = f" (entry {index[0] if len(index) == 1 else index})" if index else ""
+        exponent = np.log10(abs(float(x_[index]))) + power * np.log10(float(s))
+        value = f"{np.sign(x_[index]) * 10 ** (exponent % 1):.3g}e{int(np.floor(exponent))}"
+        raise InvalidInputError(
+            f"{what}{where} is {value}, outside the normal range of float64 (2.2e-308 to "
+            "1.8e308): rescale the input"
+        )
+    return out
+
+
+def check_edge_lengths(lengths) -> None:
+    """Raise, naming the first offending edge (entry of the concrete (ne,) `lengths`):
+    `NonFiniteError` for a NaN or infinite length, `TriangleInequalityError` for a length ≤ 0
+    (a Euclidean triangle has positive sides, Def 5.5).  Traced lengths are not inspected."""
+    if not is_concrete(lengths):
+        return
+    l = np.asarray(lengths)
+    bad = np.flatnonzero(~np.isfinite(l))
+    if bad.size:
+        raise NonFiniteError(f"edge {bad[0]} has the non-finite length {l[bad[0]]}")
+    bad = np.flatnonzero(l <= 0)
+    if bad.size:
+        raise TriangleInequalityError(f"edge {bad[0]} has the non-positive length {l[bad[0]]}")
+
+
+# A face is degenerate when |e1 × e2|² ≤ DEGENERATE |e1|²|e2|², i.e. the sine of its angle at
+# corner 0 is below ~1e-7: there the cotangents and the normal are round-off.
+DEGENERATE = 1e-14
+
+
+def check_face_areas(sin2, F) -> None:
+    """Raise `DegenerateFaceError` naming the first face (and its vertices, rows of F) whose
+    sin² of the angle at corner 0 (`sin2`, (nf,), as from `corner_weights`) is ≤ DEGENERATE
+    or NaN: a face of zero area up to round-off (Sec 6.3)."""
+    bad = np.flatnonzero(~(np.asarray(sin2) > DEGENERATE))
+    if bad.size:
+        f = int(bad[0])
+        raise DegenerateFaceError(
+            f"face {f} {np.asarray(F[f]).tolist()} has zero area (sin² of its angle {sin2[f]:.1e}): its "
+            "cotangents and normal are undefined; remove or repair degenerate triangles"
+        )
 
 
 def _sorted3(a, b, c):
@@ -68,10 +177,15 @@ def triangle_area(a, b, c):
         A = ¼ √((x + (y + z)) (z − (x − y)) (z + (x − y)) (x + (y − z))),
 
     accurate for needle-like triangles (no cancellation of rounded sums); NaN when a triangle
-    inequality fails.
+    inequality fails.  The sides are divided by the power of two m = `power_of_two_scale(x)`
+    and A(a, b, c) = m² A(a/m, b/m, c/m), so that the fourth powers stay in range for every
+    side that is a float.
     """
+    xp = _xp(a, b, c)
     x, y, z = _sorted3(a, b, c)
-    return 0.25 * _xp(a, b, c).sqrt((x + (y + z)) * (z - (x - y)) * (z + (x - y)) * (x + (y - z)))
+    m = power_of_two_scale(x)
+    x, y, z = (t * (1.0 / m) for t in (x, y, z))
+    return 0.25 * xp.sqrt((x + (y + z)) * (z - (x - y)) * (z + (x - y)) * (x + (y - z))) * m * m
 
 
 def corner_cotangents(a2, b2, c2, area):
@@ -88,8 +202,11 @@ def corner_cotangents(a2, b2, c2, area):
 
 
 def face_harmonic_index(a, b, c, area):
-    """h(Δ) = (a² + b² + c²) / A(Δ) (Def 7.7), = 4 (cot α + cot β + cot γ) by Lemma 7.17."""
-    return (a * a + b * b + c * c) / area
+    """h(Δ) = (a² + b² + c²) / A(Δ) (Def 7.7), = 4 (cot α + cot β + cot γ) by Lemma 7.17;
+    scale-invariant, evaluated on a, b, c / m and A / m² (m = `power_of_two_scale(a)`)."""
+    m = power_of_two_scale(a)
+    a, b, c = (t * (1.0 / m) for t in (a, b, c))
+    return (a * a + b * b + c * c) / (area * (1.0 / m) * (1.0 / m))
 
 
 def _area_from_squares(l2):
@@ -140,8 +257,10 @@ def _off_diagonal(K):
 
 
 def _sin2(l2):
-    """sin² of the angle at corner 0, 4A² / (l01² l02²) (0 or NaN for a degenerate face)."""
-    return 4.0 * _area_from_squares(l2) ** 2 / (l2[:, 1] * l2[:, 2])
+    """sin² of the angle at corner 0, (2A / l01²)(2A / l02²) = 4A² / (l01² l02²) (each factor
+    scale-invariant; 0 or NaN for a degenerate face)."""
+    two_area = 2.0 * _area_from_squares(l2)
+    return (two_area / l2[:, 1]) * (two_area / l2[:, 2])
 
 
 def corner_weights(l2: Float[Array, "nf 3"]):
@@ -248,14 +367,20 @@ def squared_side_lengths(P):
 
 
 def edge_lengths(V, F):
-    """l(e) = |v_j − v_i| for each edge (i, j) of `ddgjax.mesh.edges(F)`, (ne,)."""
+    """l(e) = |v_j − v_i| for each edge (i, j) of `ddgjax.mesh.edges(F)`, (ne,); computed on
+    V / s (`normalised`) and multiplied by s, so that |v_j − v_i|² need not be a float.
+
+    **Raises:** `InvalidInputError` if a length overflows float64 (`scaled_back`).
+    """
     E = from_faces(np.asarray(F), n_vertices=jnp.shape(V)[0]).edges
-    return _lengths(jnp.asarray(V), E)
+    lengths, s = _lengths(jnp.asarray(V), E)
+    return scaled_back(lengths, s, 1, "an edge length")
 
 
 @jax.jit
 def _lengths(V, E):
-    return jnp.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=-1)
+    V, s = normalised(V)
+    return jnp.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=-1), s
 
 
 def _triangles(F) -> np.ndarray:
@@ -308,8 +433,10 @@ def corner_angles(L: Float[Array, "nf 3"]) -> Float[Array, "nf 3"]:
         tan(α/2) = √((s − b)(s − c) / (s (s − a))),   s = (a + b + c)/2,
 
     a the side opposite the corner, the differences s − l in Kahan's stable order.  Unlike
-    arccos((b² + c² − a²)/2bc) it keeps full relative accuracy for angles near 0 and π.
+    arccos((b² + c² − a²)/2bc) it keeps full relative accuracy for angles near 0 and π.  Each
+    face's sides are divided by the power of two nearest its longest (angles are invariant).
     """
+    L = L * (1.0 / power_of_two_scale(jnp.max(L, axis=1, keepdims=True)))
     two_s, D = _semiperimeter_differences(L)
     Db, Dc = jnp.roll(D, -1, axis=1), jnp.roll(D, 1, axis=1)
     return 2 * jnp.arctan2(jnp.sqrt(Db * Dc), jnp.sqrt(two_s[:, None] * D))
@@ -327,10 +454,13 @@ def corner_angles_from_lengths(F, lengths):
     """Corner angles (nf, 3) of the triangles F from edge lengths ordered like
     `ddgjax.mesh.edges(F)` (`corner_angles` of `face_side_lengths`).
 
-    **Raises:** `ShapeError` for non-triangles or lengths of the wrong shape,
-    `TriangleInequalityError` naming the first face whose lengths violate a triangle inequality.
+    **Raises:** `ShapeError` for non-triangles or lengths of the wrong shape, `NonFiniteError` /
+    `TriangleInequalityError` naming an edge with a NaN, infinite or non-positive length
+    (`check_edge_lengths`), `TriangleInequalityError` naming the first face whose lengths
+    violate a triangle inequality.
     """
     L = face_side_lengths(F, lengths)
+    check_edge_lengths(lengths)
     check_triangle_inequalities(L)
     return corner_angles(L) if not is_concrete(L) else jnp.asarray(corner_angles_of_sides(L))
 
@@ -353,7 +483,8 @@ def angle_defects(h, L):
 
 def angle_defect_from_lengths(F, lengths):
     """`angle_defects` of the triangles F with edge lengths ordered like `ddgjax.mesh.edges(F)`,
-    (nv,) with nv = max(F) + 1."""
+    (nv,) with nv = max(F) + 1.  **Raises:** as `corner_angles_from_lengths`."""
     L = face_side_lengths(F, lengths)
+    check_edge_lengths(lengths)
     check_triangle_inequalities(L)
     return angle_defects(from_faces(_triangles(F)), L)

@@ -3,7 +3,8 @@
 Every function takes `F` as an (nf, k) int array, a list of polygons, a gluing word such as
 "abAB" (`gluing.from_word`), or `Halfedges`.  Vertex labels that no face uses do
 not count.  `classify` and `genus` describe one connected surface (Def 4.1) and raise
-`MeshError` for several components; split first with `connected_components`.
+`MeshError` for several components (split first with `connected_components`) or for none (an
+empty face list).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components as _components
 
 from ..errors import MeshError, OrientationError
-from .connectivity import Halfedges, as_halfedges
+from .connectivity import Halfedges, as_halfedges, check_has_faces
 
 __all__ = [
     "euler_characteristic",
@@ -138,6 +139,7 @@ def boundary_loops(F) -> list[np.ndarray]:
 
 
 def _single_component(h: Halfedges) -> None:
+    check_has_faces(h.n_faces)
     n, labels = _face_components(h)
     if n > 1:
         first = [int(np.argmax(labels == c)) for c in range(n)]
@@ -182,7 +184,7 @@ _NONORIENTABLE_NAMES = {(1, 0): "projective plane", (2, 0): "Klein bottle", (3, 
 def classification(F) -> Classification:
     """Orientability, genus or cross-caps, boundary count and χ of one connected surface.
 
-    **Raises:** `MeshError` for several components.
+    **Raises:** `MeshError` for several components or none (no faces).
     """
     h = as_halfedges(F)
     _single_component(h)
