@@ -54,11 +54,12 @@ def vm_hwm_mb() -> float:
         return next(int(line.split()[1]) for line in status if line.startswith("VmHWM")) / 1024.0
 
 
-def fresh_peak_mb(n: int, tol: float) -> tuple[float, float]:
-    """(peak MB, residual) of one sparse elastica solve with n edges, compile included, in a new
-    process: this process's peak also holds every earlier row's compiled solvers and patterns."""
+def fresh_peak_mb(problem: str, tol: float) -> tuple[float, float]:
+    """(peak MB, residual) of one sparse solve of `problem` (a call in this module, e.g.
+    "elastica_problem(100000)"), problem built and compile included, in a new process: this
+    process's peak also holds every earlier row's compiled solvers and patterns."""
     code = (f"import sys; sys.path.insert(0, {os.path.dirname(os.path.abspath(__file__))!r}); import scale; "
-            f"s = scale.solve(scale.elastica_problem({n}), method='sparse', tol={tol}, throw=False); "
+            f"s = scale.solve(scale.{problem}, method='sparse', tol={tol}, throw=False); "
             "print(scale.vm_hwm_mb(), float(s.residual))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     return float(out[-2]), float(out[-1])
@@ -174,7 +175,7 @@ def main():
             print(f"{'PASS' if big['converged'] and big['residual'] <= 1e-9 else 'FAIL'}: elastica 10⁵ edges residual "
                   f"{big['residual']:.1e} ≤ 1e-9")
             print(f"{'PASS' if big['solve'] <= 10 else 'FAIL'}: elastica 10⁵ edges solve {big['solve']:.2f} s ≤ 10 s after compile")
-            peak, residual = fresh_peak_mb(100_000, args.tol)
+            peak, residual = fresh_peak_mb("elastica_problem(100_000)", args.tol)
             print(f"{'PASS' if peak <= 2048 else 'FAIL'}: peak memory {peak:.0f} MB ≤ 2048 MB (VmHWM of a new process "
                   f"that builds, compiles and solves the 10⁵-edge elastica, residual {residual:.1e})")
         print(f"{'PASS' if p <= 1.2 else 'FAIL'}: exponent {p:.2f} ≤ 1.2")
@@ -197,6 +198,10 @@ def main():
         n, r = ar[-1]
         print(f"{'PASS' if r['converged'] else 'FAIL'}: area Newton solve with {n} vertices converged "
               f"(residual {r['residual']:.1e}, {r['steps']} steps, {r['solve']:.1f} s after compile, peak {r['peak']:.0f} MB)")
+        if n >= 90_000:
+            peak, residual = fresh_peak_mb(f"area_problem({int(round(n**0.5))})", args.tol)
+            print(f"{'PASS' if peak <= 1536 else 'FAIL'}: peak memory {peak:.0f} MB ≤ 1536 MB (VmHWM of a new process that "
+                  f"builds the {n}-vertex area problem, compiles and solves it, residual {residual:.1e})")
     if load > cores:
         print(f"note: load average {load:.1f} > {cores} cores during the run: other processes share the CPU")
 

@@ -134,8 +134,6 @@ class HostFactors:
 
     pattern: SparsePattern
     factoriser: str
-    indptr: np.ndarray = field(init=False)
-    indices: np.ndarray = field(init=False)
     _symbolic: object = field(init=False, default=None)
     _live: OrderedDict = field(init=False, default_factory=OrderedDict)
     _handles: list = field(init=False, default_factory=list)  # free Pardiso handles, analysed
@@ -143,9 +141,8 @@ class HostFactors:
     _lock: threading.Lock = field(init=False, default_factory=threading.Lock)
 
     def __post_init__(self):
-        self.indptr, self.indices = _csc_structure(self.pattern)
         rows, cols = self.pattern.rows, self.pattern.cols
-        self.upper = np.flatnonzero(cols >= rows)  # the values Pardiso reads: K's upper triangle, CSR
+        self.upper = np.flatnonzero(cols >= rows).astype(np.int32)  # the values Pardiso reads: K's upper triangle, CSR
         counts = np.bincount(rows[self.upper], minlength=self.size)
         self.upper_indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32) + 1  # 1-based
         self.upper_indices = cols[self.upper].astype(np.int32) + 1
@@ -154,10 +151,16 @@ class HostFactors:
     def size(self) -> int:
         return self.pattern.n + self.pattern.m
 
+    @functools.cached_property
+    def csc(self) -> tuple[np.ndarray, np.ndarray]:
+        """`(indptr, indices)` of K in CSC, made when a factoriser that reads CSC first needs it."""
+        return _csc_structure(self.pattern)
+
     def matrix(self, values: np.ndarray):
         import scipy.sparse as sp
 
-        return sp.csc_matrix((values, self.indices, self.indptr), shape=(self.size, self.size))
+        indptr, indices = self.csc
+        return sp.csc_matrix((values, indices, indptr), shape=(self.size, self.size))
 
     def _ldl(self, A) -> Factorisation | None:
         """CHOLMOD's simplicial `LDLᵀ` (no pivoting: the fill-reducing ordering is kept), with the
@@ -281,14 +284,20 @@ class HostFactors:
             flat_out[i] = fac.solve(np.ascontiguousarray(flat_b[i]))
         return out
 
-    def solve_complex(self, values: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Factorise-and-solve for complex values (..., nnz) and right-hand sides (..., size),
-        kept nowhere: the Levenberg–Marquardt fallback."""
+    def solve_shifted(self, values: np.ndarray, shift: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """`(K + i·shift·I)⁻¹ b` for real values (..., nnz) of K, shifts (...) and right-hand sides
+        (..., size), factorised and solved at once, kept nowhere: the Levenberg–Marquardt fallback."""
         values, b = np.asarray(values), np.asarray(b)
         flat_v = values.reshape(-1, values.shape[-1])
-        flat_b = b.reshape(flat_v.shape[0], -1)
-        out = np.stack([self._lu(self.matrix(v)).solve(np.ascontiguousarray(r)) for v, r in zip(flat_v, flat_b)])
-        return out.reshape(b.shape)
+        flat_s = np.asarray(shift).reshape(-1)
+        flat_b = b.reshape(flat_v.shape[0], -1).astype(np.complex128)
+        diagonal = self.pattern.diagonal
+        out = []
+        for v, s, r in zip(flat_v, flat_s, flat_b):
+            shifted = v.astype(np.complex128)
+            shifted[diagonal] += 1j * s
+            out.append(self._lu(self.matrix(shifted)).solve(r))
+        return np.stack(out).reshape(b.shape)
 
 
 def host_factors(pattern: SparsePattern, factoriser: str) -> HostFactors:
@@ -355,8 +364,8 @@ class SparseDirect(AssembledSparse):
         return jax.pure_callback(self.host.apply, out, fac, b, vmap_method="broadcast_all")
 
     def lm_solve_matrix(self, K, nu, R):
-        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric), one complex SuperLU solve."""
-        shifted = K.astype(jnp.complex128).at[self.index["diagonal"]].add(1j * jnp.sqrt(nu))
-        rhs = R.astype(jnp.complex128)
-        out = jax.ShapeDtypeStruct(rhs.shape, rhs.dtype)
-        return -jnp.real(jax.pure_callback(self.host.solve_complex, out, shifted, rhs, vmap_method="broadcast_all"))
+        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric), one complex SuperLU solve;
+        the complex matrix is made on the host (no complex copy of K on the device)."""
+        out = jax.ShapeDtypeStruct(R.shape, jnp.complex128)
+        shift = jnp.broadcast_to(jnp.sqrt(nu), K.shape[:-1])
+        return -jnp.real(jax.pure_callback(self.host.solve_shifted, out, K, shift, R, vmap_method="broadcast_all"))

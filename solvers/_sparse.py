@@ -5,7 +5,7 @@ For `E = Σ_k e(x[stencil_k])` the Hessian is `Σ_k P_kᵀ ∇²e P_k`: each cel
 `−λ·g` and, row by row, for the constraint Jacobian.  The pattern (which raw block entry goes
 to which coalesced matrix entry) is computed once with NumPy from the stencils and the fixed
 mask, and cached on the energy declaration; every Newton step then evaluates the blocks with
-`vmap`ed `jax.hessian` / `jax.jacfwd` and sums duplicates with one `segment_sum`.
+`vmap`ed `jax.hessian` / `jax.jacfwd` and adds each block value in place to its entry.
 """
 
 from __future__ import annotations
@@ -47,8 +47,9 @@ class SparsePattern:
     constraint_terms: tuple[TermPattern, ...]
     rows: np.ndarray  # (nnz,) int32, coalesced COO rows of the KKT matrix
     cols: np.ndarray  # (nnz,) int32
-    source: np.ndarray  # (n_raw,) int32: index into the raw block values
-    target: np.ndarray  # (n_raw + n + m,) int32: coalesced entry of each raw value, then of the diagonal
+    hessian_target: np.ndarray  # (n_hessian_raw,) int32: coalesced entry of each raw Hessian value (nnz: dropped)
+    jacobian_target: np.ndarray  # (2, n_jacobian_raw) int32: entries of each raw Jacobian value in −J and −Jᵀ
+    diagonal: np.ndarray  # (n + m,) int32: the diagonal entries
     coupled: np.ndarray  # KKT indices of the multipliers of global sums (e.g. a chord)
     key: tuple = ()  # the Spec key it was built from: equal keys give interchangeable patterns
 
@@ -173,12 +174,56 @@ def _constraint_rows(constraints: Local, x0, params):
     return out
 
 
+RAW_PER_CHUNK = 1 << 21
+"""Raw KKT entries handled at once while building a pattern: bounds its memory to a few times
+this many integers instead of several times the number of raw entries (16·10⁶ at 10⁵ vertices)."""
+
+
+def _raw_entries(terms_h, terms_j, free_of: np.ndarray, n: int, size: int):
+    """The raw KKT entries, term by term and cell by cell, in chunks of about `RAW_PER_CHUNK`:
+    `(kind, count, kept, key)`: `count` raw values of `kind` ("h": Hessian, "j": −J, "jt": −Jᵀ,
+    each in its own order), of which those at `kept` add to a free entry with key row·size + col
+    (entries on fixed unknowns are dropped)."""
+    for tp in terms_h:  # Hessian blocks: every (row, col) pair of a cell's columns
+        K, sd = tp.columns.shape
+        step = max(1, RAW_PER_CHUNK // (sd * sd))
+        for k0 in range(0, K, step):
+            cols = free_of[tp.columns[k0 : k0 + step]]
+            fr = np.repeat(cols, sd, axis=1).ravel()
+            fc = np.tile(cols, (1, sd)).ravel()
+            kept = np.flatnonzero((fr >= 0) & (fc >= 0))
+            yield "h", fr.size, kept, fr[kept] * size + fc[kept]
+    for tp in terms_j:  # Jacobian blocks, stored once, used for −J (rows n + r) and −Jᵀ
+        K, sd = tp.columns.shape
+        c = tp.rows.shape[1]
+        step = max(1, RAW_PER_CHUNK // (c * sd))
+        for k0 in range(0, K, step):
+            kc = len(tp.columns[k0 : k0 + step])
+            rr = n + np.repeat(tp.rows[k0 : k0 + step], sd, axis=1).ravel()
+            fc = free_of[np.broadcast_to(tp.columns[k0 : k0 + step, None, :], (kc, c, sd))].ravel()
+            kept = np.flatnonzero(fc >= 0)
+            yield "j", fc.size, kept, rr[kept] * size + fc[kept]
+            yield "jt", fc.size, kept, fc[kept] * size + rr[kept]
+
+
+def _distinct(a: np.ndarray) -> np.ndarray:
+    """The sorted distinct values of `a` (by a sort: numpy's hashing `unique` is slower on keys)."""
+    a = np.sort(a)
+    return a[np.concatenate([[True], a[1:] != a[:-1]])] if a.size else a
+
+
 def build_pattern(spec: Spec, x0, params) -> SparsePattern:
-    """Static sparsity of the KKT matrix of a local problem (see module docstring)."""
+    """Static sparsity of the KKT matrix of a local problem (see module docstring).
+
+    Two passes over the raw entries in chunks: the sorted distinct keys (row·size + col, the
+    diagonal included), then each raw entry's position among them (`searchsorted`), or nnz for
+    an entry on a fixed unknown (a slot that `kkt_values` drops).
+    """
     shape = spec.layout.shapes[0]
     width = shape[1] if len(shape) == 2 else 1
     n_rows = shape[0]
     n, m = spec.n, spec.m
+    size = n + m
     free_of = np.full(spec.layout.n_total, -1, dtype=np.int64)
     free_of[spec.layout.free] = np.arange(n)
 
@@ -186,41 +231,27 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
     cons = [] if spec.constraints is None else _constraint_rows(spec.constraints, x0, params)
     constraint_terms = tuple(TermPattern(t, _columns(t, width, n_rows), rows) for t, rows in cons)
 
-    r_list, c_list, src_list, offset = [], [], [], 0
-    for tp in energy_terms + constraint_terms:  # Hessian blocks
-        K, sd = tp.columns.shape
-        rr = np.repeat(tp.columns, sd, axis=1).ravel()
-        cc = np.tile(tp.columns, (1, sd)).ravel()
-        fr, fc = free_of[rr], free_of[cc]
-        keep = (fr >= 0) & (fc >= 0)
-        r_list.append(fr[keep]); c_list.append(fc[keep])
-        src_list.append(offset + np.flatnonzero(keep))
-        offset += K * sd * sd
-    for tp in constraint_terms:  # Jacobian blocks, stored once, used for -J and -Jᵀ
-        K, sd = tp.columns.shape
-        c = tp.rows.shape[1]
-        rr = np.repeat(tp.rows, sd, axis=1).reshape(K, c, sd)
-        cc = np.broadcast_to(tp.columns[:, None, :], (K, c, sd))
-        fc = free_of[cc.ravel()]
-        keep = fc >= 0
-        src = offset + np.flatnonzero(keep)
-        r_list += [n + rr.ravel()[keep], fc[keep]]
-        c_list += [fc[keep], n + rr.ravel()[keep]]
-        src_list += [src, src]
-        offset += K * c * sd
-    diag = np.arange(n + m)
-    rows = np.concatenate(r_list + [diag])
-    cols = np.concatenate(c_list + [diag])
-    keys, target = np.unique(rows * (n + m) + cols, return_inverse=True)
+    def entries():
+        return _raw_entries(energy_terms + constraint_terms, constraint_terms, free_of, n, size)
+
+    diagonal = np.arange(size, dtype=np.int64) * (size + 1)
+    keys = _distinct(np.concatenate([_distinct(key) for *_, key in entries()] + [diagonal]))
+    targets = {"h": [], "j": [], "jt": []}
+    for kind, count, kept, key in entries():
+        target = np.full(count, keys.size, dtype=np.int32)
+        target[kept] = np.searchsorted(keys, key)
+        targets[kind].append(target)
+    joined = {kind: np.concatenate(t) if t else np.zeros((0,), np.int32) for kind, t in targets.items()}
     return SparsePattern(
         n=n,
         m=m,
         energy_terms=energy_terms,
         constraint_terms=constraint_terms,
-        rows=(keys // (n + m)).astype(np.int32),
-        cols=(keys % (n + m)).astype(np.int32),
-        source=np.concatenate(src_list).astype(np.int32),
-        target=target.astype(np.int32),
+        rows=(keys // size).astype(np.int32),
+        cols=(keys % size).astype(np.int32),
+        hessian_target=joined["h"],
+        jacobian_target=np.stack([joined["j"], joined["jt"]]),
+        diagonal=np.searchsorted(keys, diagonal).astype(np.int32),
         coupled=np.unique([n + r for tp in constraint_terms if tp.term.reduce == "sum" for r in tp.rows[0]]).astype(np.int64),
         key=spec.key(),
     )
@@ -235,14 +266,58 @@ def cached_pattern(spec: Spec, x0, params) -> SparsePattern:
     return PATTERNS.get(spec.key(), lambda: build_pattern(spec, x0, params))
 
 
-def _cell_hessians(term: Term, x, params, weights=None):
+CELLS_PER_CHUNK = 1 << 13
+"""Cells whose Hessian blocks are evaluated and added at once: the assembly's working memory is
+a chunk's blocks, not every cell's (at 10⁵ vertices that is 8·10³ faces' blocks instead of 2·10⁵)."""
+
+
+def chunk_count(cells: int) -> int:
+    """Number of chunks of at most `CELLS_PER_CHUNK` cells, and at least 1."""
+    return max(1, -(-cells // CELLS_PER_CHUNK))
+
+
+def in_chunks(a: np.ndarray, chunks: int, fill) -> np.ndarray:
+    """(K, ...) → (chunks, ⌈K / chunks⌉, ...): consecutive cells, the last chunk padded with `fill`."""
+    size = -(-len(a) // chunks)
+    padded = np.concatenate([a, np.full((chunks * size - len(a),) + a.shape[1:], fill, a.dtype)])
+    return padded.reshape((chunks, size) + a.shape[1:])
+
+
+def _hessian_chunks(pattern: SparsePattern) -> dict:
+    """Per Hessian term i: its cells' stencils, constraint rows and entries in chunks
+    (`cells_i`, `rows_i`, `targets_i`); padding cells read row 0 and add to the dropped slot."""
+    arrays, offset = {}, 0
+    for i, tp in enumerate(pattern.energy_terms + pattern.constraint_terms):
+        K, sd = tp.columns.shape
+        chunks = chunk_count(K)
+        targets = pattern.hessian_target[offset : offset + K * sd * sd].reshape(K, sd * sd)
+        arrays[f"cells_{i}"] = in_chunks(tp.term.stencil, chunks, 0)
+        arrays[f"targets_{i}"] = in_chunks(targets, chunks, pattern.nnz)
+        if tp.rows is not None:
+            arrays[f"rows_{i}"] = in_chunks(tp.rows, chunks, 0)
+        offset += K * sd * sd
+    return arrays
+
+
+def _add_cell_hessians(K, term: Term, x, params, cells, targets, lam=None, rows=None):
+    """K + Σ_k P_kᵀ ∇²e_k P_k over the term's cells, chunk by chunk (`cells`, `targets`, `rows`
+    from `_hessian_chunks`); for a constraint term `e_k = −λ_{rows_k} · g_k`."""
+
     def cell_value(xl, dk, wk):
         val = jnp.ravel(term.cell(xl, dk, params))
         return val[0] if wk is None else -jnp.dot(wk, val)
 
-    local = x[term.stencil]
-    H = jax.vmap(jax.hessian(cell_value), in_axes=(0, 0, 0))(local, term.data, weights)
-    return H.reshape(-1)
+    def add_chunk(K, chunk):
+        st, tg, dk, rk = chunk
+        weights = None if rk is None else lam[rk]
+        H = jax.vmap(jax.hessian(cell_value), in_axes=(0, 0, 0))(x[st], dk, weights)
+        return K.at[tg.reshape(-1)].add(H.reshape(-1)), None
+
+    chunks = cells.shape[0]
+    data = jax.tree_util.tree_map(lambda leaf: in_chunks(np.asarray(leaf), chunks, np.asarray(leaf)[:1]), term.data)
+    if chunks == 1:
+        return add_chunk(K, jax.tree_util.tree_map(lambda a: a[0], (cells, targets, data, rows)))[0]
+    return jax.lax.scan(add_chunk, K, (cells, targets, data, rows))[0]
 
 
 def _cell_jacobians(term: Term, x, params):
@@ -251,31 +326,28 @@ def _cell_jacobians(term: Term, x, params):
     return J.reshape(-1)
 
 
-def cell_blocks(pattern: SparsePattern, kkt: KKT, w, identity_hessian: bool):
-    """Raw values `(hessian blocks, jacobian blocks)` in the order `build_pattern` expects."""
-    u, lam = kkt.split(w)
-    x = kkt.x(u)
-    if identity_hessian:
-        size = sum(tp.columns.shape[0] * tp.columns.shape[1] ** 2 for tp in pattern.energy_terms + pattern.constraint_terms)
-        hess = jnp.zeros((size,), dtype=w.dtype)
-    else:
-        pieces = [_cell_hessians(tp.term, x, kkt.params) for tp in pattern.energy_terms]
-        pieces += [_cell_hessians(tp.term, x, kkt.params, lam[tp.rows]) for tp in pattern.constraint_terms]
-        hess = jnp.concatenate(pieces)
-    jac = [_cell_jacobians(tp.term, x, kkt.params) for tp in pattern.constraint_terms]
-    return hess, (jnp.concatenate(jac) if jac else jnp.zeros((0,), dtype=w.dtype))
-
-
 def kkt_values(pattern: SparsePattern, index: dict, kkt: KKT, w, identity_hessian: bool = False):
     """Coalesced COO values (at `pattern.rows`, `pattern.cols`) of K at w (∇²L replaced by I if asked);
-    `index = index_arrays(pattern)`, or the same arrays traced."""
-    n, m = pattern.n, pattern.m
-    hess, jac = cell_blocks(pattern, kkt, w, identity_hessian)
-    raw = jnp.concatenate([hess, -jac])
-    # a concatenation, not `zeros.at[:n].add`: XLA constant-folds that scatter (seconds at 10⁵)
-    diag = jnp.concatenate([jnp.full((n,), 1.0 if identity_hessian else 0.0), jnp.zeros((m,))])
-    values = jnp.concatenate([raw[index["source"]], diag])
-    return jax.ops.segment_sum(values, index["target"], num_segments=pattern.nnz)
+    `index = index_arrays(pattern)`, or the same arrays traced.
+
+    Each raw block value is added in place to its entry (a scatter-add into nnz + 1 slots, the
+    last one collecting the values on fixed unknowns and padding cells), the Hessian blocks
+    chunk by chunk: no array of all raw values is made.
+    """
+    n = pattern.n
+    u, lam = kkt.split(w)
+    x = kkt.x(u)
+    K = jnp.zeros((pattern.nnz + 1,), dtype=w.dtype)
+    if identity_hessian:
+        K = K.at[index["diagonal"][:n]].add(1.0)
+    else:
+        for i, tp in enumerate(pattern.energy_terms + pattern.constraint_terms):
+            K = _add_cell_hessians(K, tp.term, x, kkt.params, index[f"cells_{i}"], index[f"targets_{i}"],
+                                   lam, index.get(f"rows_{i}"))
+    if pattern.constraint_terms:
+        jac = jnp.concatenate([_cell_jacobians(tp.term, x, kkt.params) for tp in pattern.constraint_terms])
+        K = K.at[index["jacobian_target"][0]].add(-jac).at[index["jacobian_target"][1]].add(-jac)
+    return K[: pattern.nnz]
 
 
 SPLIT_ARRAYS = ("interior", "border", "a_rows", "a_cols", "take_a", "b_rows", "b_cols", "take_b",
@@ -294,13 +366,15 @@ def index_arrays(pattern: SparsePattern) -> dict:
 
 def _device_index_arrays(pattern: SparsePattern) -> dict:
     h_at, j_at = pattern.blocks()
-    arrays = {"source": pattern.source, "target": pattern.target, "rows": pattern.rows, "cols": pattern.cols,
-              "diagonal": pattern.target[pattern.source.shape[0]:], "h_at": h_at, "j_at": j_at}
+    arrays = {"jacobian_target": pattern.jacobian_target, "rows": pattern.rows, "cols": pattern.cols,
+              "diagonal": pattern.diagonal, "h_at": h_at, "j_at": j_at, **_hessian_chunks(pattern)}
     split = pattern.split()
     if split is not None:
         arrays.update({f"split_{name}": getattr(split, name) for name in SPLIT_ARRAYS})
-    with jax.ensure_compile_time_eval():  # concrete arrays even when first made under a trace (shard_map)
-        return {k: jnp.asarray(np.asarray(v, dtype=np.int32)) for k, v in arrays.items()}
+    # `device_put`, not `jnp.asarray`: on the CPU it shares the NumPy buffer instead of copying it;
+    # concrete arrays even when first made under a trace (shard_map)
+    with jax.ensure_compile_time_eval():
+        return {k: jax.device_put(np.ascontiguousarray(v, dtype=np.int32)) for k, v in arrays.items()}
 
 
 class PatternKey:

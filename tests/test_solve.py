@@ -144,10 +144,15 @@ def test_sparse_and_dense_paths_agree():
     assert float(jnp.max(jnp.abs(local_dense.x - dense.x))) <= 1e-10
 
 
-def test_sparse_kkt_matrix_equals_dense_hessian():
-    """Assembled cell blocks (incl. −λ·∇²g and ±J) equal jax.hessian of the Lagrangian."""
+@pytest.mark.parametrize("cells_per_chunk", [1 << 13, 3])
+def test_sparse_kkt_matrix_equals_dense_hessian(monkeypatch, cells_per_chunk):
+    """Assembled cell blocks (incl. −λ·∇²g and ±J) equal jax.hessian of the Lagrangian, also
+    when the cells are assembled in chunks (3 cells per chunk: 3 chunks, the last one padded)."""
+    import solvers._sparse
     from solvers._kkt import KKT, spec_of
-    from solvers._sparse import build_pattern, cell_blocks
+
+    monkeypatch.setattr(solvers._sparse, "CELLS_PER_CHUNK", cells_per_chunk)
+    from solvers._sparse import build_pattern, index_arrays, kkt_values
 
     problem = unit_chain(8, chord=(6.5, 3.5, 0.2))
     spec = spec_of(problem)
@@ -156,10 +161,12 @@ def test_sparse_kkt_matrix_equals_dense_hessian():
     kkt = KKT(spec, z0, problem.params)
     rng = np.random.default_rng(0)
     w = jnp.asarray(rng.normal(size=spec.n + spec.m))
-    hess, jac = jax.jit(lambda w: cell_blocks(pattern, kkt, w, False))(w)
-    raw = jnp.concatenate([hess, -jac])
-    values = jnp.concatenate([raw[pattern.source], jnp.zeros(spec.n + spec.m)])
-    coo = np.asarray(jax.ops.segment_sum(values, pattern.target, num_segments=pattern.nnz))
+    coo = np.asarray(jax.jit(lambda w: kkt_values(pattern, index_arrays(pattern), kkt, w))(w))
+    identity = np.asarray(jax.jit(lambda w: kkt_values(pattern, index_arrays(pattern), kkt, w, True))(w))
+    K = np.zeros((spec.n + spec.m,) * 2)
+    K[pattern.rows, pattern.cols] = identity
+    dense = np.asarray(jax.jit(jax.hessian(kkt.lagrangian))(w))
+    assert np.array_equal(K[: spec.n, : spec.n], np.eye(spec.n)) and np.max(np.abs(K[spec.n :] - dense[spec.n :])) <= 1e-12
     K = np.zeros((spec.n + spec.m,) * 2)
     K[pattern.rows, pattern.cols] = coo
     dense = np.asarray(jax.jit(jax.hessian(kkt.lagrangian))(w))
@@ -203,15 +210,20 @@ def test_residual_scale_is_applied():
     np.testing.assert_allclose(float(scaled.residual), 1e-3 * float(plain.residual), rtol=1e-12)
 
 
-def test_klu_solve_with_sorted_indices_matches_dense():
-    """Our direct use of KLU (pre-sorted indices, reused symbolic analysis) solves K x = b."""
+@pytest.mark.parametrize("back_end", ["klu", "superlu"])
+def test_sparse_solves_match_dense(back_end):
+    """Our direct use of KLU (pre-sorted indices, reused symbolic analysis) and the host
+    factorisation solve K x = b, and the Levenberg–Marquardt step (KᵀK + νI) d = −Kᵀ b (complex
+    shift of K made on the device for KLU, on the host for `SparseDirect`)."""
+    from solvers._direct import SparseDirect
     from solvers._kkt import KKT, spec_of
     from solvers._klu import KLU
-    from solvers._sparse import build_pattern
+    from solvers._sparse import build_pattern, index_arrays
 
     problem = unit_chain(9, chord=(7.5, 3.5, 0.2))
     spec = spec_of(problem)
-    algebra = KLU(build_pattern(spec, problem.x0, problem.params))
+    pattern = build_pattern(spec, problem.x0, problem.params)
+    algebra = KLU(pattern) if back_end == "klu" else SparseDirect(pattern, index_arrays(pattern), factoriser=back_end)
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
     rng = np.random.default_rng(3)
     w, b = (jnp.asarray(rng.normal(size=spec.n + spec.m)) for _ in range(2))
