@@ -59,6 +59,7 @@ __all__ = [
     "load",
     "resample",
     "great_circle",
+    "initial_tangents",
     "unit_vector",
     "theorem_3_8_a",
     "pendulum_gravity",
@@ -173,15 +174,19 @@ def _perpendicular(a, xp=np):
     return p / xp.linalg.norm(p)
 
 
-def great_circle(a, b, s, xp=np):
-    """Points `cos(θs) a + sin(θs) u` (len(s), 3) of the great-circle arc from the unit vector a
-    (s = 0) to b (s = 1): θ = ∠(a, b) and u the unit vector orthogonal to a in the plane of a, b
-    (through `_perpendicular(a)` when b = ±a).  `xp`: the array module (NumPy or jax.numpy)."""
+def great_circle(a, b, s, xp=np, amplitude=0.0):
+    """Points `cos ψ(s) a + sin ψ(s) u` (len(s), 3) of the great circle through the unit vectors
+    a and b, with `ψ(s) = θs + A sin(2πs)`: θ = ∠(a, b) and u the unit vector orthogonal to a in
+    the plane of a, b (`_perpendicular(a)` when b = ±a).  With the `amplitude` A = 0 the arc from
+    a (s = 0) to b (s = 1); with A ≠ 0 the same ends, the tangent turning back and forth in the
+    plane like the first buckling mode of a column clamped at both ends (ψ − θs antisymmetric
+    about s = ½).  `xp`: the array module (NumPy or jax.numpy)."""
     a, b, s = xp.asarray(a, dtype=float), xp.asarray(b, dtype=float), xp.asarray(s, dtype=float)
     u = b - (a @ b) * a
     norm = xp.linalg.norm(u)  # sin θ
     u = xp.where(norm > 1e-9, u / xp.where(norm > 1e-9, norm, 1.0), _perpendicular(a, xp))
-    angle = xp.arctan2(norm, a @ b) * s[:, None]  # accurate at θ ≈ 0 and θ ≈ π, unlike arccos
+    theta = xp.arctan2(norm, a @ b)  # accurate at θ ≈ 0 and θ ≈ π, unlike arccos
+    angle = (theta * s + amplitude * xp.sin(2.0 * np.pi * s))[:, None]
     return xp.cos(angle) * a + xp.sin(angle) * u
 
 
@@ -231,14 +236,10 @@ def clamp_ends(X0, first, last) -> tuple[jax.Array, np.ndarray]:
     return X0, fixed
 
 
-def initial_tangents(n: int, length, chord, t_start, t_end, steps: int = 50):
-    """A rough start: the great-circle interpolation T of the end tangents, shifted by a
-    constant vector s and renormalised, `U = (T + s)/|T + s|`, with s from the fixed-point
-    iteration `s ← s + chord/length − mean(U)` (so that h Σ U ≈ chord).  No derivative
-    (`start_data`)."""
-    xp, (length, chord, t_start, t_end) = start_data(length, chord, t_start, t_end)
-    T = great_circle(t_start, t_end, xp.linspace(0.0, 1.0, n), xp)
-    target = chord / length
+def chord_shifted(T, target, steps: int, xp=np):
+    """`U = (T + σ)/|T + σ|` with the constant vector σ from the fixed-point iteration
+    `σ ← σ + target − mean(U)`, σ = 0 first: tangents whose mean approaches `target`
+    (= chord/L, so that h Σ U ≈ chord) when the rows of T are spread out enough."""
 
     def shifted(shift):
         U = T + shift
@@ -248,6 +249,59 @@ def initial_tangents(n: int, length, chord, t_start, t_end, steps: int = 50):
     for _ in range(steps):
         shift = shift + target - shifted(shift).mean(axis=0)
     return shifted(shift)
+
+
+# the first minimum of the Bessel function J_0: mean_s cos(A sin 2πs) = J_0(A) decreases on [0, it]
+BUCKLING_AMPLITUDE_MAX = 3.8317059702075125
+
+
+def buckling_amplitude(a, b, s, target, xp=np, steps: int = 40):
+    """The amplitude A ∈ [0, `BUCKLING_AMPLITUDE_MAX`] of the buckled arc
+    `great_circle(a, b, s, amplitude=A)` whose mean has the component of `target` along the
+    mean of the plain arc, by bisection.  For parallel ends (a = b) the mean is `J_0(A) a` in the
+    limit of many points, decreasing in A; a target beyond `J_0(A_max) ≈ −0.40` gets A_max."""
+    axis = great_circle(a, b, s, xp).mean(axis=0)
+    axis = axis / xp.linalg.norm(axis)
+    wanted = target @ axis
+    low, high = xp.asarray(0.0), xp.asarray(BUCKLING_AMPLITUDE_MAX)
+    for _ in range(steps):
+        mid = 0.5 * (low + high)
+        too_long = great_circle(a, b, s, xp, amplitude=mid).mean(axis=0) @ axis > wanted
+        low, high = xp.where(too_long, mid, low), xp.where(too_long, high, mid)
+    return 0.5 * (low + high)
+
+
+def chord_mismatch(U, target, xp=np):
+    """`|mean(U) − target|`, +∞ when not finite: how far h Σ U is from the chord, over L."""
+    mismatch = xp.linalg.norm(U.mean(axis=0) - target)
+    return xp.where(xp.isfinite(mismatch), mismatch, xp.inf)
+
+
+START_MISMATCH = 1e-3  # a chord_shifted arc meets the chord to ~1e-4 or better when it can
+
+
+def initial_tangents(n: int, length, chord, t_start, t_end, steps: int = 50):
+    """A rough start: the great-circle arc from t_start to t_end (`great_circle`, s = k/(n−1)),
+    made to meet the chord by `chord_shifted`.
+
+    When that cannot meet it (mean tangent off by more than `START_MISMATCH`, or not finite) the
+    end tangents are (nearly) parallel to each other and to the chord: Euler buckling, where the
+    straight arc is a bifurcation point and shifting all the tangents by one vector keeps them
+    parallel (or divides by zero).  The start is then the arc buckled in its plane,
+    `great_circle(..., amplitude=A)`, `A = buckling_amplitude(...)` so that its mean tangent
+    has the chord's component along the plain arc — the first buckling mode ψ(s) = A sin(2πs)
+    of a column clamped at both ends, ends unchanged — then `chord_shifted` for the rest.  No
+    derivative (`start_data`).
+    """
+    xp, (length, chord, t_start, t_end) = start_data(length, chord, t_start, t_end)
+    s, target = xp.linspace(0.0, 1.0, n), chord / length
+    with np.errstate(invalid="ignore", divide="ignore"):  # the failed plain start, when it fails
+        plain = chord_shifted(great_circle(t_start, t_end, s, xp), target, steps, xp)
+    amplitude = buckling_amplitude(t_start, t_end, s, target, xp)
+    buckled = chord_shifted(great_circle(t_start, t_end, s, xp, amplitude=amplitude), target, steps, xp)
+    plain_error, buckled_error = chord_mismatch(plain, target, xp), chord_mismatch(buckled, target, xp)
+    use_buckled = (plain_error > START_MISMATCH) & (buckled_error < plain_error)
+    return xp.where(use_buckled, buckled, plain)
 
 
 def clamped(

@@ -11,12 +11,14 @@ import jax
 import jax.numpy as jnp
 
 from ._kkt import KKT
-from ._linear import MU_FLOOR, LinearSolver, regularisation
+from ._linear import LinearSolver, row_regularisation
 
 
 @jax.tree_util.register_pytree_node_class
 class DenseLU(LinearSolver):
     """Dense KKT matrix by `jax.hessian` of the Lagrangian; LU solve.  A pytree without leaves."""
+
+    iterative_refinement = True
 
     def tree_flatten(self):
         return (), None
@@ -37,9 +39,9 @@ class DenseLU(LinearSolver):
         return jax.hessian(kkt.lagrangian)(w)
 
     def factor_matrix(self, kkt: KKT, K, mu_rel):
-        scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
-        K = K + jnp.diag(regularisation(kkt.spec.n, kkt.spec.m, jnp.maximum(mu_rel * scale, MU_FLOOR)))
-        return jax.scipy.linalg.lu_factor(K)
+        """`lu_factor(K + μS)`, μ scaled row by row (`row_regularisation`)."""
+        mu_s = row_regularisation(kkt.spec.n, kkt.spec.m, mu_rel, jnp.max(jnp.abs(K), axis=1))
+        return jax.scipy.linalg.lu_factor(K + jnp.diag(mu_s))
 
     def apply(self, fac, b):
         return jax.scipy.linalg.lu_solve(fac, b)
@@ -49,6 +51,10 @@ class DenseLU(LinearSolver):
 
     def matvec(self, K, v):
         return K @ v
+
+    def solve_once(self, kkt, w, mu_rel, b):
+        """The LU solve itself: JAX transposes it and differentiates it again (`jax.hessian`)."""
+        return self.solve(kkt, w, mu_rel, b)
 
     def lm_solve_matrix(self, K, nu, R):
         normal = K.T @ K + nu * jnp.eye(K.shape[0])

@@ -284,6 +284,33 @@ class HostFactors:
             flat_out[i] = fac.solve(np.ascontiguousarray(flat_b[i]))
         return out
 
+    def solve_once(self, values: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """`K⁻¹ b` for values (..., nnz) and right-hand sides (..., size), leading axes broadcast
+        (a leading axis of length 1 in `values`: one factorisation for every right-hand side);
+        Pardiso borrows a pooled handle and returns it."""
+        values, b = np.asarray(values), np.asarray(b)
+        lead = values.ndim - 1
+        shape = np.broadcast_shapes(values.shape[:lead], b.shape[:lead])
+        flat_b = np.broadcast_to(b, shape + b.shape[lead:]).reshape((-1,) + b.shape[lead:])
+        flat_v = values.reshape(-1, values.shape[-1])
+        out = np.empty(flat_b.shape, np.float64)
+        fac, row = None, -1
+        for i in range(len(flat_b)):
+            want = i if len(flat_v) > 1 else 0
+            if want != row:
+                fac, row = self._borrowed(flat_v[want], fac), want
+            out[i] = fac.solve(np.ascontiguousarray(flat_b[i]))
+        self._borrowed(None, fac)
+        return out.reshape(shape + b.shape[lead:])
+
+    def _borrowed(self, values, previous: Factorisation | None) -> Factorisation | None:
+        """Return `previous`'s handle to the pool; factorise `values` (if given) in a pooled one."""
+        with self._lock:
+            if previous is not None and previous.handle is not None:
+                self._handles.append(previous.handle)
+            handle = self._handles.pop() if values is not None and self._handles else None
+        return None if values is None else self.factorise(np.ascontiguousarray(values), handle)
+
     def solve_shifted(self, values: np.ndarray, shift: np.ndarray, b: np.ndarray) -> np.ndarray:
         """`(K + i·shift·I)⁻¹ b` for real values (..., nnz) of K, shifts (...) and right-hand sides
         (..., size), factorised and solved at once, kept nowhere: the Levenberg–Marquardt fallback."""
@@ -362,6 +389,19 @@ class SparseDirect(AssembledSparse):
     def apply(self, fac, b):
         out = jax.ShapeDtypeStruct(b.shape, b.dtype)
         return jax.pure_callback(self.host.apply, out, fac, b, vmap_method="broadcast_all")
+
+    def solve_once(self, kkt, w, mu_rel, b):
+        """Factorise and solve in one host call, factorisation freed after it (the derivative's
+        solve): unlike `factor` + `apply`, no order between independent calls is needed.  Under
+        `vmap` over right-hand sides only (`jacfwd`, `jacrev`) the matrix is factorised once."""
+        values = self.regularised(self.matrix(kkt, w), mu_rel)
+
+        def host_solve(_, rhs):
+            out = jax.ShapeDtypeStruct(rhs.shape, rhs.dtype)
+            return jax.pure_callback(self.host.solve_once, out, values, rhs, vmap_method="expand_dims")
+
+        # a host call is not transposable by JAX: declared a linear solve, with K + μS symmetric
+        return jax.lax.custom_linear_solve(lambda v: self.matvec(values, v), b, host_solve, symmetric=True)
 
     def lm_solve_matrix(self, K, nu, R):
         """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric), one complex SuperLU solve;

@@ -15,7 +15,7 @@ import jax
 import jax.numpy as jnp
 
 from ._kkt import KKT
-from ._linear import MU_FLOOR, LinearSolver, regularisation
+from ._linear import LinearSolver, row_regularisation
 from ._sparse import SPLIT_ARRAYS, PatternKey, SparsePattern, cached_pattern, index_arrays, kkt_values
 
 
@@ -60,6 +60,7 @@ class AssembledSparse(LinearSolver):
     static part compares by the pattern's structure (`PatternKey`)."""
 
     needs_locality = True
+    iterative_refinement = True
 
     def __init__(self, pattern: SparsePattern | None = None, index: dict | None = None):
         self.pattern = pattern
@@ -97,10 +98,10 @@ class AssembledSparse(LinearSolver):
         return self.regularised(K, mu_rel)
 
     def regularised(self, K, mu_rel):
-        """The values of `K + μS`, μ = mu_rel · max(|K|, 1)."""
+        """The values of `K + μS`, μ scaled row by row (`row_regularisation`)."""
         n, m = self.pattern.n, self.pattern.m
-        scale = jnp.maximum(jnp.max(jnp.abs(K)), 1.0)
-        return K.at[self.index["diagonal"]].add(regularisation(n, m, jnp.maximum(mu_rel, MU_FLOOR) * scale))
+        row_max = jax.ops.segment_max(jnp.abs(K), self.index["rows"], num_segments=n + m)
+        return K.at[self.index["diagonal"]].add(row_regularisation(n, m, mu_rel, row_max))
 
     def matvec(self, K, v):
         return jax.ops.segment_sum(K * v[self.index["cols"]], self.index["rows"], num_segments=v.shape[0])

@@ -1,9 +1,15 @@
-"""The linear-solver interface of Newton–KKT: solve the regularised KKT system `(K + μ S) d = b`.
+"""The linear-solver interface of Newton–KKT: solve the regularised KKT system `(K + μS) d = b`.
 
-`S = diag(I_n, −I_m)`.  The regularisation makes the system solvable when the KKT matrix is
-singular (a continuous symmetry of the energy, redundant constraints); with μ proportional to
-the residual it leaves Newton's quadratic convergence intact.  `μ` is given relative to the
-largest entry of `K`, so that it means the same whatever the scaling of the energy.
+`S = diag(I_n, −I_m)`, μ a diagonal.  The regularisation makes the system solvable when the KKT
+matrix is singular (a continuous symmetry of the energy, redundant constraints).  It is scaled
+to the problem row by row (`row_regularisation`): `μ_i = mu_rel · max_j |K_ij|`, a relative
+perturbation of each row of the size of the round-off a factorisation commits anyway, so that
+it means the same whatever the scaling of the energy, of the constraints or of single unknowns,
+and does not swamp a small eigenvalue that belongs to a small row (a diagonal quadratic with
+condition number 10¹⁶ is solved exactly).  The direct back ends then correct the regularised
+solve once with the unregularised K (`apply_refined`): the Newton step is K's own to
+`O(μ²/λ²)` in an eigendirection with eigenvalue λ, where the plain regularised step is off by
+`μ/λ`.
 
 A back end is a `LinearSolver`: a pytree (its array data are arguments of the compiled solver,
 its static data the jit cache key) with
@@ -14,6 +20,7 @@ its static data the jit cache key) with
   (dense array, coalesced sparse values, or products), evaluated once per Newton step;
 - `factor_matrix(kkt, K, mu_rel) -> fac`: `K + μS` made ready to solve with (factorised);
 - `apply(fac, b)`: solve with it (Newton's damping test reuses one factorisation);
+- `apply_refined(fac, K, b)`: the same, refined once with K when `iterative_refinement`;
 - `apply_transpose(fac, b)`: solve with the transpose, for the adjoint of implicit
   differentiation (`K + μS` is symmetric, so by default the same solve);
 - `matvec(K, v)`: `K v`;
@@ -34,14 +41,28 @@ from __future__ import annotations
 
 import abc
 
+import jax
 import jax.numpy as jnp
 
 MU_FLOOR = 1e-300
+ROW_FLOOR = float(jnp.finfo(jnp.float64).eps)  # rows below this, relative to the largest, are round-off
 
 
 def regularisation(n: int, m: int, mu):
-    """The diagonal of `μS = μ diag(I_n, −I_m)`."""
-    return jnp.concatenate([jnp.full((n,), mu), jnp.full((m,), -mu)])
+    """The diagonal of `μS = μ diag(I_n, −I_m)` (μ a scalar or an (n + m,) array)."""
+    sign = jnp.concatenate([jnp.ones((n,)), -jnp.ones((m,))])
+    return sign * jnp.broadcast_to(mu, (n + m,))
+
+
+def row_regularisation(n: int, m: int, mu_rel, row_max):
+    """The diagonal of `μS` scaled row by row: `μ_i = mu_rel · max(r_i, ε r_max)` with the row
+    sizes `r_i = max_j |K_ij|` (`row_max`, (n + m,)), at least `MU_FLOOR`.
+
+    A zero row (an unknown on which nothing depends, a constraint with a vanishing gradient)
+    gets `mu_rel · ε · r_max`: rows below `ε r_max` are at the round-off level of the largest.
+    """
+    scale = jnp.maximum(row_max, ROW_FLOOR * jnp.max(row_max, initial=0.0))
+    return regularisation(n, m, jnp.maximum(mu_rel * scale, MU_FLOOR))
 
 
 class LinearSolver(abc.ABC):
@@ -49,6 +70,8 @@ class LinearSolver(abc.ABC):
 
     #: True if the back end needs a problem declared local (`dg.local_sum`): it assembles K sparsely
     needs_locality: bool = False
+    #: True if `apply_refined` refines (a factorisation: one more back substitution is cheap)
+    iterative_refinement: bool = False
 
     def bind(self, problem, spec) -> LinearSolver:
         """This solver prepared for `problem` (called once per solve, outside any trace)."""
@@ -62,6 +85,19 @@ class LinearSolver(abc.ABC):
 
     @abc.abstractmethod
     def apply(self, fac, b): ...
+
+    def apply_refined(self, fac, K, b):
+        """`d = (K + μS)⁻¹ b`, then, if `iterative_refinement`, one step of iterative refinement
+        with the unregularised K: `d + (K + μS)⁻¹ (b − K d)`.
+
+        In an eigendirection of K with eigenvalue λ the regularised solve is off by the factor
+        `λ/(λ + μ)` and the refined one by `1 − μ²/(λ + μ)²`; in a null direction (λ = 0,
+        where b has only round-off) the refined step is twice the regularised one.
+        """
+        d = self.apply(fac, b)
+        if not self.iterative_refinement:
+            return d
+        return d + self.apply(fac, b - self.matvec(K, d))
 
     def apply_transpose(self, fac, b):
         """`(K + μS)ᵀ⁻¹ b`; K and S are symmetric."""
@@ -78,3 +114,13 @@ class LinearSolver(abc.ABC):
 
     def solve(self, kkt, w, mu_rel, b, identity_hessian: bool = False):
         return self.apply(self.factor(kkt, w, mu_rel, identity_hessian), b)
+
+    def solve_once(self, kkt, w, mu_rel, b):
+        """`(K + μS)⁻¹ b` as one self-contained operation, linear in `b` and transposable (the
+        derivative's solve): declared to JAX as a linear solve of the symmetric `K + μS`, so
+        that reverse mode transposes it as the same solve.  A back end whose solve JAX can
+        transpose and differentiate itself (dense LU) returns `solve` directly."""
+        K = self.matrix(kkt, w)
+        return jax.lax.custom_linear_solve(
+            lambda v: self.matvec(K, v), b, lambda _, rhs: self.solve(kkt, w, mu_rel, rhs), symmetric=True
+        )

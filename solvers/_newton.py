@@ -1,7 +1,8 @@
 """Globalised Newton's method on the KKT system `R(w) = 0` (Newton / Levenberg–Marquardt hybrid).
 
 Each step first tries the Newton step `Δ = −K⁻¹R` (with a regularisation μ = 1e-14 relative to
-the largest entry of K, enough to factorise an exactly singular K), damped `αΔ` with
+each row of K, enough to factorise an exactly singular K, and one step of iterative refinement
+with the unregularised K: `LinearSolver.apply_refined`), damped `αΔ` with
 α = 1, ½, … until Deuflhard's natural monotonicity test holds (`_newton_trial`); near a
 solution the full step is taken, so convergence is quadratic, and a quadratic program takes
 one step.
@@ -69,7 +70,7 @@ def _newton_trial(kkt: KKT, linear, K, w, R):
     `K = linear.matrix(kkt, w)`.
     """
     fac = linear.factor_matrix(kkt, K, NEWTON_MU)
-    delta = linear.apply(fac, -R)
+    delta = linear.apply_refined(fac, K, -R)
     size = jnp.linalg.norm(delta)
 
     def cond(carry):

@@ -16,7 +16,7 @@ from ._first_order import augmented_lagrangian
 from ._implicit import implicit_solution
 from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
 from ._banded import chain_structure
-from ._cache import derived
+from ._cache import LRU, cleared_by_jax, derived
 from ._dense import DenseLU
 from ._direct import SparseDirect, default_factoriser
 from ._klu import KLU
@@ -38,7 +38,7 @@ class Solution(NamedTuple):
     - `energy`: `E(x)`.
     - `residual`: max-norm of the (scaled) KKT residual at `x`.
     - `steps`: Newton steps taken (outer augmented-Lagrangian steps for `method="lbfgs"`).
-    - `converged`: `residual <= tol`.
+    - `converged`: `residual <= tol` and the energy finite at `x`.
     - `history`: residual after each step (`history[0]` at the start of Newton).
     - `status`: 0 converged, 1 max_steps reached, 2 stalled, 3 non-finite.
     """
@@ -113,11 +113,32 @@ def linear_solver_of(problem: Problem, spec: Spec, method: str, linear_solver: L
     return linear_solver.bind(problem, spec)
 
 
-@partial(jax.jit, static_argnames=("spec", "tol", "max_steps", "first_order", "newton_phase"))
+COMPILED_SOLVERS = 32
+"""Compiled solvers kept by `solve`, one per problem declaration and options (least recently
+used dropped first, with every trace and executable JAX keeps for it): a new `lambda` energy per
+call costs a compilation each time but no longer grows memory without bound."""
+
+JITTED = cleared_by_jax(LRU(COMPILED_SOLVERS), "solvers.solve compiled solvers")
+
+
 def _solve_jit(spec, linear, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
+    """`_solve_impl` compiled once per (declaration, options), through the bounded `JITTED`."""
+    static = dict(tol=tol, max_steps=max_steps, first_order=first_order, newton_phase=newton_phase)
+    jitted = JITTED.get((spec, tuple(static.items())), lambda: jax.jit(partial(_solve_impl, spec, **static)))
+    return jitted(linear, z0, params, lam0, weights)
+
+
+def compiled_solver_count() -> int:
+    """The number of executables `solve` holds (over every declaration in `JITTED`)."""
+    return sum(jitted._cache_size() for jitted in JITTED._items.values())
+
+
+def _solve_impl(spec, linear, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
     z0_, params_ = jax.lax.stop_gradient((z0, params))
     kkt = KKT(spec, z0_, params_)
     u0 = z0_[spec.layout.free]
+    if lam0 is None and spec.m == 0:
+        lam0 = jnp.zeros((0,), u0.dtype)
     if lam0 is None:
         # least-squares multipliers argmin |∇E − Jᵀλ|: the KKT system with ∇²L replaced by I
         grad_e = jax.grad(kkt.energy)(u0)
@@ -138,12 +159,15 @@ def _solve_jit(spec, linear, z0, params, lam0, weights, *, tol, max_steps, first
         finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
         status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
 
-    w = implicit_solution(spec, jax.lax.stop_gradient(linear), w, z0, params)
+    kkt_final = KKT(spec, z0_, params_)
+    converged = (residual <= tol) & jnp.isfinite(kkt_final.energy(kkt_final.split(w)[0]))
+    status = jnp.where((status == CONVERGED) & ~converged, NONFINITE, status)
+    w = implicit_solution(spec, jax.lax.stop_gradient(linear), w, z0, params, converged)
     kkt_diff = KKT(spec, z0, params)
     u, lam = kkt_diff.split(w)
     x = kkt_diff.x(u)
     energy = kkt_diff.energy(u)
-    return Solution(x, spec.constraint_structure.unravel(lam), energy, residual, steps, residual <= tol, history, status)
+    return Solution(x, spec.constraint_structure.unravel(lam), energy, residual, steps, converged, history, status)
 
 
 def solve(
@@ -177,16 +201,18 @@ def solve(
       CPU, else dense up to N = n + m = 2,000 unknowns and multipliers, else Krylov).
     - `linear_solver`: a `solvers.LinearSolver` object (`DenseLU()`, `KLU()`, `SparseDirect()`,
       `Krylov(rtol=…)`, or your own) for the Newton steps; overrides `method`'s choice.
-    - `throw`: raise `ConvergenceError` when not converged (only outside `jit`/`vmap`; inside
-      them check `Solution.converged`).
+    - `throw`: raise `ConvergenceError` when not converged; inside `jit`/`vmap` the compiled
+      computation raises at run time instead (`equinox.error_if`; an `EqxRuntimeError` naming the
+      problem). With `throw=False` check `Solution.converged`.
     - `multipliers0`: starting multipliers, flat or named like `Solution.multipliers` (default:
       least squares `argmin |∇E − Jᵀλ|` at x0).
     - `warm_start="lbfgs"`: run up to 50 augmented-Lagrangian L-BFGS steps before Newton, for
       minimisation problems started far away.
 
-    **Returns:** a `Solution`. `jax.grad`/`jax.jacobian` of functions of `.x`, `.multipliers`,
-    `.energy` with respect to `problem.params` (and `x0`'s fixed entries) are exact (implicit
-    function theorem), and `jax.vmap` over `params` works (also under `jit`, on both the dense and
+    **Returns:** a `Solution`. Derivatives of functions of `.x`, `.multipliers`, `.energy` with
+    respect to `problem.params` (and `x0`'s fixed entries) are exact (implicit function theorem),
+    in reverse mode (`grad`, `jacrev`, `vjp`) and forward mode (`jvp`, `jacfwd`, `hessian`); they
+    are NaN when the solve did not converge. `jax.vmap` over `params` works (also under `jit`, on both the dense and
     the sparse path; `solve_batch` packages it and shards a batch over devices).
 
     **Raises:** `ConvergenceError` (with `.residual`, `.steps`, `.solution`), `NonFiniteError`
@@ -214,14 +240,29 @@ def solve(
             spec, linear, z0, problem.params, lam0, residual_weights(problem, spec),
             tol=float(tol), max_steps=int(max_steps), first_order=first_order, newton_phase=method != "lbfgs",
         )
+        if not is_concrete(sol):
+            return _raise_if_not_converged(problem, sol) if throw else sol
+        jax.block_until_ready(sol)  # a failure in the computation surfaces here, not later
     except jax.errors.JaxRuntimeError as err:  # KLU and the host factorisations report a singular matrix so
         raise ConvergenceError(
-            f"{_label(problem)}the sparse linear solve failed ({err}); try method='dense' to diagnose",
+            f"{_label(problem)}the sparse linear solve failed ({_first_line(err)}); try method='dense' to diagnose",
             residual=float("nan"), steps=0,
         ) from None
-    if not is_concrete(sol):
-        return sol
     return _finish(problem, sol, throw, tol)
+
+
+def _first_line(error: BaseException) -> str:
+    return str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+
+
+def _raise_if_not_converged(problem: Problem, sol: Solution) -> Solution:
+    """`sol` with a run-time check: the compiled computation raises unless every member of a
+    (possibly batched) solve converged."""
+    import equinox as eqx
+
+    message = f"{_label(problem)}solve did not converge (throw=True inside jit/vmap; pass throw=False and check .converged)"
+    x, multipliers, energy = eqx.error_if((sol.x, sol.multipliers, sol.energy), ~sol.converged, message)
+    return sol._replace(x=x, multipliers=multipliers, energy=energy)
 
 
 def _label(problem: Problem) -> str:
@@ -238,9 +279,11 @@ def _finish(problem: Problem, sol: Solution, throw: bool, tol: float) -> Solutio
             f"{float(sol.residual)}): check the energy's domain at the starting point"
         )
     if throw and not bool(sol.converged):
+        where = (f"with energy {float(sol.energy)} at the last iterate (KKT residual {float(sol.residual):.3e})"
+                 if status == NONFINITE else f"with KKT residual {float(sol.residual):.3e} > tol {tol:.1e}")
         raise ConvergenceError(
             f"{_label(problem)}solve did not converge: {STATUS_TEXT.get(status, status)} after {steps} "
-            f"steps with KKT residual {float(sol.residual):.3e} > tol {tol:.1e}. Try a better x0, "
+            f"steps {where}. Try a better x0, "
             "warm_start='lbfgs' (for minimisation), a larger max_steps, or a looser tol.",
             residual=float(sol.residual), steps=steps, solution=sol,
         )

@@ -266,11 +266,11 @@ def test_solve_inside_jit_returns_flags_instead_of_raising():
 
 def test_repeated_solves_reuse_the_compiled_solver():
     """Problems built from the same functions and shapes share one compilation."""
-    from solvers._solve import _solve_jit
+    from solvers._solve import compiled_solver_count
 
     A = random_symmetric(8, 0)
     solve(rayleigh(A, np.ones(8)))
-    before = _solve_jit._cache_size()
+    before = compiled_solver_count()
     for seed in range(3):
         solve(rayleigh(random_symmetric(8, seed), np.random.default_rng(seed).normal(size=8)))
-    assert _solve_jit._cache_size() == before
+    assert compiled_solver_count() == before
