@@ -1,8 +1,13 @@
-"""`solve_batch`: one problem solved for a batch of parameters, vectorised and sharded over devices."""
+"""`solve_batch`: one problem solved for a batch of parameters, vectorised and sharded over devices.
+
+The compiled batch solver is cached by the problem's structure in the bounded `COMPILED`
+(`_cache.LRU`): a second call on a problem declared alike reuses the executable.
+"""
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import jax
 import jax.numpy as jnp
@@ -12,28 +17,42 @@ from jax.sharding import Mesh, NamedSharding, PartitionSpec
 from ddgjax.errors import ConvergenceError, InvalidInputError, ShapeError
 from ddgjax.problem import Problem
 
-from ._solve import METHODS, Solution, solve
+from ._cache import LRU, cleared_by_jax
+from ._kkt import spec_of
+from ._solve import METHODS, Solution, linear_solver_of, solve
 
 BATCH_AXIS = "batch"
 
+COMPILED_BATCH_SOLVERS = 32
+"""Executables `solve_batch` keeps, the least recently used dropped first (each is megabytes
+and, on the CPU, a few hundred memory mappings)."""
+
+COMPILED = cleared_by_jax(LRU(COMPILED_BATCH_SOLVERS), "solvers.solve_batch executables")
+"""`solve_batch`'s executables by structure (`structure_key`); `jax.clear_caches()` empties it."""
+
 
 def _split_params(problem: Problem, params_batch):
-    """`(batched, merge)`: the batched leaves and a function putting them back into full params.
+    """`(batched, shared)`: the batched leaves, and the unbatched entries of dict params (None
+    when `params_batch` has the whole structure of `problem.params`); see `_merge`.
 
     `params_batch` is either a pytree like `problem.params` with a leading batch axis on every
     leaf, or (for dict params) a dict of some of its keys, the others kept from `problem`.
     """
     base = problem.params
     if isinstance(base, dict) and isinstance(params_batch, dict) and set(params_batch) < set(base):
-        fixed = {k: v for k, v in base.items() if k not in params_batch}
-        return params_batch, lambda batched: {**fixed, **batched}
+        return params_batch, {k: v for k, v in base.items() if k not in params_batch}
     if jax.tree_util.tree_structure(params_batch) != jax.tree_util.tree_structure(base):
         raise ShapeError(
             "params_batch must have the structure of problem.params (or, for dict params, a subset "
             f"of its keys): got {jax.tree_util.tree_structure(params_batch)}, "
             f"expected {jax.tree_util.tree_structure(base)}"
         )
-    return params_batch, lambda batched: batched
+    return params_batch, None
+
+
+def _merge(shared, member):
+    """A member's full params: its batched entries joined to the shared ones."""
+    return member if shared is None else {**shared, **member}
 
 
 def _batch_size(batched) -> int:
@@ -44,6 +63,78 @@ def _batch_size(batched) -> int:
     if len(sizes) != 1:
         raise ShapeError(f"the leaves of params_batch have different batch sizes {sorted(sizes)}")
     return sizes.pop()
+
+
+def _device_tuple(devices) -> tuple | None:
+    """`devices` as a tuple (`"all"`: `jax.devices()`), or None for the default device."""
+    if devices is None:
+        return None
+    devices = tuple(jax.devices() if devices == "all" else devices)
+    if not devices:
+        raise InvalidInputError("solve_batch: devices is empty")
+    return devices
+
+
+def batch_arguments(problem: Problem, shared, linear_solver, batched) -> tuple:
+    """The arrays of a batch solve, `(x0, shared, residual_scale, linear_solver, batched)`, every
+    leaf a `jax.Array`: what varies between problems declared alike is an argument of the
+    compiled solver, not a constant inside it."""
+    args = (problem.x0, shared, problem.residual_scale, linear_solver, batched)
+    return jax.tree_util.tree_map(jnp.asarray, args)
+
+
+def structure_key(problem: Problem, args: tuple, options: tuple, devices) -> tuple:
+    """What the compiled solver depends on: the declaration (`Spec`: the energy and constraint
+    functions, by identity or, declared local, by value; the layout of the unknowns and the
+    fixed entries), the options, the devices and backend, and the arguments' tree structure,
+    shapes, dtypes and placements — not their values."""
+    leaves, treedef = jax.tree_util.tree_flatten(args)
+    avals = tuple((jax.typeof(a), a.sharding) for a in leaves)
+    return (spec_of(problem), options, devices, jax.default_backend(), treedef, avals)
+
+
+def _member_solver(problem: Problem, method: str, tol: float, max_steps: int):
+    """`(x0, shared, residual_scale, linear_solver, p) -> Solution`: `solve` of the member with
+    batched params `p`; only `problem`'s functions and fixed entries are closed over."""
+
+    def one(x0, shared, scale, linear_solver, p):
+        member = replace(problem, x0=x0, params=_merge(shared, p), residual_scale=scale)
+        return solve(member, method=method, linear_solver=linear_solver, tol=tol, max_steps=max_steps, throw=False)
+
+    return one
+
+
+def _compile(problem: Problem, args: tuple, options: tuple, devices):
+    """The executable of `jax.vmap` of `_member_solver` over the batch axis of `args[-1]`
+    (`jax.shard_map` over `devices` when given), compiled for `args`."""
+    method, tol, max_steps = options
+    # the host-side analysis (sparsity pattern, multigrid hierarchy) from the concrete problem,
+    # as `solve` makes it, and its errors before any tracing
+    linear_solver_of(problem, spec_of(problem), method, args[3])
+    batched = jax.vmap(_member_solver(problem, method, tol, max_steps), in_axes=(None, None, None, None, 0))
+    if devices is not None:
+        # shard_map, not jit with shardings: XLA's partitioner cannot split KLU's custom call,
+        # and partitioning the batched Newton loop took minutes to compile
+        mesh = _mesh(devices)
+        replicated, split = PartitionSpec(), PartitionSpec(BATCH_AXIS)
+        batched = jax.shard_map(batched, mesh=mesh, in_specs=(replicated,) * 4 + (split,), out_specs=split, check_vma=False)
+    return jax.jit(batched).lower(*args).compile()
+
+
+def _mesh(devices) -> Mesh:
+    return Mesh(np.array(devices), (BATCH_AXIS,))
+
+
+def _placed(args: tuple, size: int, devices) -> tuple:
+    """`args` on the mesh of `devices`: the batch padded with copies of its last member to a
+    multiple of the number of devices and split along `"batch"`, the rest replicated."""
+    padded = math.ceil(size / len(devices)) * len(devices)
+    batched = args[-1]
+    if padded > size:
+        batched = jax.tree_util.tree_map(lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], padded - size, axis=0)]), batched)
+    mesh = _mesh(devices)
+    shared = jax.device_put(args[:-1], NamedSharding(mesh, PartitionSpec()))
+    return (*shared, jax.device_put(batched, NamedSharding(mesh, PartitionSpec(BATCH_AXIS))))
 
 
 def solve_batch(
@@ -71,6 +162,16 @@ def solve_batch(
     factorisations inside the compiled call), `"dense"` (batched LU, any backend) and
     `"krylov"` (matrix-free, any backend).  `"auto"` picks as `solve` does (`choose_method`).
 
+    **Compiled once per structure.**  The executable is kept in `solvers._batch.COMPILED`, an
+    LRU of at most `COMPILED_BATCH_SOLVERS` (32) entries, keyed by the problem's declaration
+    (the same energy and constraint functions, by identity, or declared with `dg.local_sum`,
+    by value; the same fixed entries), the shapes and dtypes of `x0` and of the parameters,
+    the batch size, `method`, `linear_solver`, `tol`, `max_steps` and `devices`.  The values
+    of `x0`, of the parameters and of `residual_scale` are arguments of the executable, so a
+    second call on a problem declared alike runs without tracing or compiling.  A new function
+    per call (a fresh `lambda`) is a new structure: it compiles, and the least recently used
+    executable is dropped.  `jax.clear_caches()` empties the cache.
+
     **Arguments:**
     - `problem`: the template; its `x0`, `fixed`, functions and the unbatched parameters are
       shared by the batch.
@@ -97,43 +198,29 @@ def solve_batch(
     """
     if method not in METHODS or method == "lbfgs":
         raise InvalidInputError(f"solve_batch: method must be one of auto, dense, sparse, krylov, got {method!r}")
-    batched, merge = _split_params(problem, params_batch)
+    batched, shared = _split_params(problem, params_batch)
     size = _batch_size(batched)
-
-    def one(p):
-        return solve(problem.with_params(merge(p)), method=method, linear_solver=linear_solver, tol=tol, max_steps=max_steps, throw=False)
-
-    if devices is None:
-        sol = jax.jit(jax.vmap(one))(batched)
-    else:
-        devices = list(jax.devices() if devices == "all" else devices)
-        if not devices:
-            raise InvalidInputError("solve_batch: devices is empty")
-        sol = _sharded(one, batched, size, devices)
+    devices = _device_tuple(devices)
+    args = batch_arguments(problem, shared, linear_solver, batched)
+    if devices is not None:
+        args = _placed(args, size, devices)
+    options = (method, float(tol), int(max_steps))
+    compiled = COMPILED.get(structure_key(problem, args, options, devices), lambda: _compile(problem, args, options, devices))
+    sol = compiled(*args)
+    if sol.steps.shape[0] > size:  # the padding of `_placed`
+        sol = jax.tree_util.tree_map(lambda a: a[:size], sol)
     if throw:
-        bad = np.flatnonzero(~np.asarray(sol.converged))
-        if bad.size:
-            k = int(bad[0])
-            raise ConvergenceError(
-                f"solve_batch: member {k} (and {bad.size - 1} more) did not converge: KKT residual "
-                f"{float(sol.residual[k]):.3e} > tol {tol:.1e} after {int(sol.steps[k])} steps",
-                residual=float(sol.residual[k]), steps=int(sol.steps[k]), solution=sol,
-            )
+        _raise_if_not_converged(sol, tol)
     return sol
 
 
-def _sharded(one, batched, size: int, devices) -> Solution:
-    n_dev = len(devices)
-    padded = math.ceil(size / n_dev) * n_dev
-    pad = jax.tree_util.tree_map(
-        lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], padded - size, axis=0)]) if padded > size else jnp.asarray(a),
-        batched,
-    )
-    mesh = Mesh(np.array(devices), (BATCH_AXIS,))
-    spec = PartitionSpec(BATCH_AXIS)
-    pad = jax.device_put(pad, NamedSharding(mesh, spec))
-    # shard_map, not jit with shardings: XLA's partitioner cannot split KLU's custom call, and
-    # partitioning the batched Newton loop took minutes to compile
-    run = jax.jit(jax.shard_map(jax.vmap(one), mesh=mesh, in_specs=spec, out_specs=spec, check_vma=False))
-    sol = run(pad)
-    return jax.tree_util.tree_map(lambda a: a[:size], sol) if padded > size else sol
+def _raise_if_not_converged(sol: Solution, tol: float) -> None:
+    """`ConvergenceError` naming the first member of `sol` that did not converge."""
+    bad = np.flatnonzero(~np.asarray(sol.converged))
+    if bad.size:
+        k = int(bad[0])
+        raise ConvergenceError(
+            f"solve_batch: member {k} (and {bad.size - 1} more) did not converge: KKT residual "
+            f"{float(sol.residual[k]):.3e} > tol {tol:.1e} after {int(sol.steps[k])} steps",
+            residual=float(sol.residual[k]), steps=int(sol.steps[k]), solution=sol,
+        )

@@ -165,12 +165,12 @@ def test_meshes_are_not_chains():
 def test_elastica_declared_alike_reuse_the_compiled_krylov_solver():
     """Each `elastica.clamped(n, ...)` call builds a new declaration (and pattern, and chain);
     equal structure must still hit jit's cache."""
-    from solvers._solve import _solve_jit
+    from solvers._solve import compiled_solver_count
 
     solve(_elastica(), method="krylov")
-    before = _solve_jit._cache_size()
+    before = compiled_solver_count()
     for k in range(2):
         problem = _elastica()
         solve(problem.with_params({**problem.params, "chord": jnp.asarray(problem.params["chord"]) * (0.95 - 0.05 * k)}),
               method="krylov")
-    assert _solve_jit._cache_size() == before
+    assert compiled_solver_count() == before
