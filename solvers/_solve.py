@@ -8,7 +8,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ddgjax._checks import is_concrete
+from ddgjax._checks import check_positive, is_concrete
 from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError
 from ddgjax.problem import Problem, flatten_multipliers
 
@@ -223,8 +223,7 @@ def solve(
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
     if warm_start not in (None, "lbfgs"):
         raise InvalidInputError(f"warm_start must be None or 'lbfgs', got {warm_start!r}")
-    if not (tol > 0):
-        raise InvalidInputError(f"tol must be positive, got {tol}")
+    check_positive(tol, "tol")
     if int(max_steps) < 0:
         raise InvalidInputError(f"max_steps must be >= 0, got {max_steps}")
     lam0 = None if multipliers0 is None else flatten_multipliers(problem, multipliers0)

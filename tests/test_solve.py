@@ -274,3 +274,11 @@ def test_repeated_solves_reuse_the_compiled_solver():
     for seed in range(3):
         solve(rayleigh(random_symmetric(8, seed), np.random.default_rng(seed).normal(size=8)))
     assert compiled_solver_count() == before
+
+
+@pytest.mark.parametrize("tol", [0.0, -1.0, float("inf"), float("nan")])
+def test_tol_must_be_finite_and_positive(tol):
+    problem = dg.Problem(energy=lambda x, p: jnp.sum(x**2), x0=jnp.ones(2))
+    with pytest.raises(dg.errors.InvalidInputError, match="tol must be finite and positive"):
+        solve(problem, tol=tol)
+    assert bool(solve(problem, tol=1e-10).converged)  # negative control
