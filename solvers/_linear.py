@@ -121,6 +121,5 @@ class LinearSolver(abc.ABC):
         that reverse mode transposes it as the same solve.  A back end whose solve JAX can
         transpose and differentiate itself (dense LU) returns `solve` directly."""
         K = self.matrix(kkt, w)
-        return jax.lax.custom_linear_solve(
-            lambda v: self.matvec(K, v), b, lambda _, rhs: self.solve(kkt, w, mu_rel, rhs), symmetric=True
-        )
+        fac = self.factor_matrix(kkt, K, mu_rel)  # K assembled once, for the product and the factorisation
+        return jax.lax.custom_linear_solve(lambda v: self.matvec(K, v), b, lambda _, rhs: self.apply(fac, rhs), symmetric=True)
