@@ -13,6 +13,10 @@ The package is layered; each layer imports only the layers above it in this list
 3. smooth reference solutions: `smooth` (exact elastica, the Lagrange top, Kirchhoff rods);
 4. output: `plot`;
 5. the application: `verify`, `cli` (the only part that imports `energies` and `solvers`).
+
+Subpackages and the names below are loaded on first use (PEP 562), so that `import ddgjax`
+costs little more than `import jax`: `ddgjax.mesh`, `from ddgjax import Problem` and
+`import ddgjax.flows` all work as usual.
 """
 
 import importlib as _importlib
@@ -21,40 +25,50 @@ import jax as _jax
 
 _jax.config.update("jax_enable_x64", True)
 
-from . import curves as curves  # noqa: E402
-from . import errors as errors  # noqa: E402
-from . import frames as frames  # noqa: E402
-from . import intrinsic as intrinsic  # noqa: E402
-from . import laplace as laplace  # noqa: E402
-from . import limits as limits  # noqa: E402
-from . import mesh as mesh  # noqa: E402
-from . import plot as plot  # noqa: E402
-from . import quaternion as quaternion  # noqa: E402
-from . import smooth as smooth  # noqa: E402
-from .flows import (  # noqa: E402
-    gradient_flow as gradient_flow,
-    hamiltonian_flow as hamiltonian_flow,
-    integrate as integrate,
-    lie_bracket as lie_bracket,
-    spin_poisson as spin_poisson,
-)
-from .locality import concat as concat, local_map as local_map, local_sum as local_sum  # noqa: E402
-from .plot import surface as plot_surface  # noqa: E402, F401  (the old name of ddgjax.plot.surface)
-from .problem import Problem as Problem, euler_lagrange as euler_lagrange, lagrangian as lagrangian  # noqa: E402
-from .smooth import top as top  # noqa: E402
-
 __version__ = "0.1.0"
 
-# Modules that moved into the layered subpackages, still importable as attributes of ddgjax
-# (`from ddgjax.smooth import kirchhoff`); loaded on first use.
-_MOVED = {
+# Names defined in a submodule, loaded from it on first access: name -> (module, attribute).
+_NAMES = {
+    "Problem": (".problem", "Problem"),
+    "euler_lagrange": (".problem", "euler_lagrange"),
+    "lagrangian": (".problem", "lagrangian"),
+    "concat": (".locality", "concat"),
+    "local_map": (".locality", "local_map"),
+    "local_sum": (".locality", "local_sum"),
+    "gradient_flow": (".flows", "gradient_flow"),
+    "hamiltonian_flow": (".flows", "hamiltonian_flow"),
+    "integrate": (".flows", "integrate"),
+    "lie_bracket": (".flows", "lie_bracket"),
+    "spin_poisson": (".flows", "spin_poisson"),
+}
+
+# Modules available as attributes of ddgjax; the last four under the names they had before
+# moving into the layered subpackages (`from ddgjax import kirchhoff` still works).
+_MODULES = {
+    **{name: f".{name}" for name in (
+        "curves", "errors", "flows", "frames", "intrinsic", "laplace", "limits", "locality", "mesh",
+        "plot", "problem", "quaternion", "smooth")},
+    "top": ".smooth.top",
     "elastica_exact": ".smooth.elastica",
     "kirchhoff": ".smooth.kirchhoff",
     "plot_laplace": ".plot.laplace",
+    "plot_surface": ".plot.surface",
 }
+
+__all__ = sorted([*_NAMES, *_MODULES, "__version__"])
 
 
 def __getattr__(name: str):
-    if name in _MOVED:
-        return _importlib.import_module(_MOVED[name], __name__)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    if name in _NAMES:
+        module, attribute = _NAMES[name]
+        value = getattr(_importlib.import_module(module, __name__), attribute)
+    elif name in _MODULES:
+        value = _importlib.import_module(_MODULES[name], __name__)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # later accesses are plain attribute lookups
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

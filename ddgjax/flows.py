@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from typing import Callable
 
-import diffrax
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -240,6 +239,8 @@ def _fixed_steps(fy, y0, t1, steps, stages, cy):
 
 
 def _adaptive(fy, y0, t1, rtol, saves, cy):
+    import diffrax  # here, not at module level: it costs half a second to import
+
     ts = jnp.linspace(0.0, t1, saves)
     term = diffrax.ODETerm(lambda t, y, args: fy(y))
     controller = diffrax.PIDController(rtol=rtol, atol=rtol * 1e-2)

@@ -19,10 +19,6 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore", DeprecationWarning)
-    import jaxopt
-
 from ._kkt import KKT, scaled_residual
 
 
@@ -37,6 +33,10 @@ class FirstOrderState(NamedTuple):
 
 def augmented_lagrangian(kkt: KKT, w0, weights, *, tol: float, outer_steps: int, inner_steps: int = 500):
     """Run at most `outer_steps` outer iterations; returns `(w, outer steps taken, residual)`."""
+    with warnings.catch_warnings():  # imported here: jaxopt pulls in scipy.optimize and numba
+        warnings.simplefilter("ignore", DeprecationWarning)
+        import jaxopt
+
     n = kkt.spec.n
 
     def L_rho(u, lam, rho):
