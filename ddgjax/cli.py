@@ -5,11 +5,16 @@
     ddgjax solve rod --n 60 --alpha 0.7 --chord 0.6 0 0 --twist 2.5 --plot rod.png
     ddgjax solve minimal-surface --mesh annulus --height 0.4 --method cotan --plot surface.png
     ddgjax bench [--quick] [NAME ...]
+    ddgjax --version                        (also `python -m ddgjax --version`)
 
 Exit codes: 0 success, 1 a check failed (verify) or a benchmark script failed (bench), 2 bad
 input: a `DDGError` (also a malformed argument, a mesh file that cannot be read, an output path
 that cannot be written) is printed as one line `ddgjax: error: … (hint: …)`, without a traceback
 unless `--debug`.
+
+`solve` and `verify` keep XLA's compiled programs on disk (`ddgjax.compile_cache`): a second
+cold run loads them instead of compiling.  `DDGJAX_COMPILE_CACHE=DIR` moves the cache,
+`DDGJAX_COMPILE_CACHE=off` switches it off.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from . import __version__, compile_cache
 from .errors import DDGError, InvalidInputError
 
 __all__ = ["main", "build_parser", "hint_for"]
@@ -298,6 +304,7 @@ def _vector(name: str, default):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="ddgjax", description="Variational discrete differential geometry in JAX.")
     parser.add_argument("--debug", action="store_true", help="show tracebacks instead of one-line errors")
+    parser.add_argument("--version", action="version", version=f"ddgjax {__version__}")
     commands = parser.add_subparsers(dest="command", required=True)
 
     verify = commands.add_parser("verify", help="check every implemented statement of the reference; write a report")
@@ -349,6 +356,8 @@ def main(argv: list[str] | None = None) -> int:
     args = None
     try:
         args = build_parser().parse_args(argv)
+        if args.command in ("solve", "verify"):  # not for `bench`, which measures compile times
+            compile_cache.enable()
         return args.run(args)
     except (DDGError, OSError) as error:
         if getattr(args, "debug", False):

@@ -13,28 +13,37 @@ from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ._kkt import KKT
 from ._linear import LinearSolver, row_regularisation
-from ._sparse import SPLIT_ARRAYS, PatternKey, SparsePattern, cached_pattern, index_arrays, kkt_values
+from ._sparse import SPLIT_ARRAYS, Bordered, PatternKey, SparsePattern, cached_pattern, index_arrays, kkt_values
 
 
-def _klu_solve(rows, cols, values, b, symbolic):
+def _klu_solve(rows, cols, values, b, handle):
     """Solve with KLU, reusing a symbolic analysis, for COO indices already sorted by (row, col).
 
     `klujax.solve_with_symbol` lexsorts the indices on every call; our patterns are sorted
     when built (`np.unique`), so we bind its primitive directly (`tests/test_solve.py` checks
-    this against `klujax.solve`).
+    this against `klujax.solve`).  `handle` is the analysis' address (`symbolic_handle`), an
+    argument of the compiled program: as a constant it would make every process compile a
+    different program, and a program loaded from the persistent cache point into another
+    process' memory.
     """
     import klujax
 
-    handle = jnp.asarray(symbolic.raw, dtype=jnp.uint64)
     rhs = b.reshape(1, b.shape[0], -1)  # (n_lhs = 1, n_col, n_rhs)
     solve = klujax.solve_with_symbol_c128 if jnp.iscomplexobj(values) else klujax.solve_with_symbol_f64
     x = solve.bind(
         jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], rhs, handle
     )
     return x.reshape(b.shape)
+
+
+def symbolic_handle(pattern: SparsePattern | Bordered) -> jax.Array:
+    """The address of the KLU analysis that `pattern` keeps alive, as a uint64 scalar."""
+    with jax.ensure_compile_time_eval():
+        return jax.device_put(np.uint64(pattern.symbolic().raw))
 
 
 def _bordered_solve(split, index: dict, values, b):
@@ -46,7 +55,7 @@ def _bordered_solve(split, index: dict, values, b):
     Bt = jnp.zeros((p, n_in), values.dtype).at[ix["bt_rows"], ix["bt_cols"]].add(values[ix["take_bt"]])
     C = jnp.zeros((p, p), values.dtype).at[ix["c_rows"], ix["c_cols"]].add(values[ix["take_c"]])
     rhs = jnp.concatenate([b[ix["interior"]][:, None], B], axis=1)
-    Y = _klu_solve(ix["a_rows"], ix["a_cols"], values[ix["take_a"]], rhs, split.symbolic())
+    Y = _klu_solve(ix["a_rows"], ix["a_cols"], values[ix["take_a"]], rhs, index["klu_symbolic"])
     schur = C - Bt @ Y[:, 1:]
     x_border = jnp.linalg.solve(schur, b[ix["border"]] - Bt @ Y[:, 0])
     x_interior = Y[:, 0] - Y[:, 1:] @ x_border
@@ -65,12 +74,13 @@ class AssembledSparse(LinearSolver):
     def __init__(self, pattern: SparsePattern | None = None, index: dict | None = None):
         self.pattern = pattern
         if index is None and pattern is not None:
-            self.prepare(pattern)
-            index = index_arrays(pattern)
+            index = {**index_arrays(pattern), **self.prepare(pattern)}
         self.index = index
 
-    def prepare(self, pattern: SparsePattern) -> None:
-        """The back end's analysis of the pattern, made once, outside any trace."""
+    def prepare(self, pattern: SparsePattern) -> dict:
+        """The back end's analysis of the pattern, made once, outside any trace; returns the
+        further arguments its solves take (added to the index arrays)."""
+        return {}
 
     def bind(self, problem, spec):
         return type(self)(cached_pattern(spec, problem.x0, problem.params))
@@ -111,15 +121,16 @@ class AssembledSparse(LinearSolver):
 class KLU(AssembledSparse):
     """Sparse KKT matrix assembled from local blocks; KLU solve (klujax), inside `jit`."""
 
-    def prepare(self, pattern: SparsePattern) -> None:
-        if pattern.split() is None:  # KLU's analysis, made now, outside any trace
-            pattern.symbolic()
+    def prepare(self, pattern: SparsePattern) -> dict:
+        """KLU's analysis of K (or of its interior block), made now, outside any trace."""
+        split = pattern.split()
+        return {"klu_symbolic": symbolic_handle(pattern if split is None else split)}
 
     def apply(self, fac, b):
         split = self.pattern.split()
         if split is not None:
             return _bordered_solve(split, self.index, fac, b)
-        return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.pattern.symbolic())
+        return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.index["klu_symbolic"])
 
     def lm_solve_matrix(self, K, nu, R):
         """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric: `(K + isI)⁻¹ = (K − isI)(K² + s²I)⁻¹`),

@@ -3,6 +3,9 @@
 The tests solve small problems many times over: XLA's compile time, not run time, is most of
 the suite's time, so they run with LLVM's backend optimisation off (about half the compile
 time of a Newton solver; set before JAX starts its backend).  Set XLA_FLAGS to override.
+The compiled programs are kept in the persistent compilation cache of the command line
+(`ddgjax.compile_cache`, the user's cache folder; `DDGJAX_COMPILE_CACHE=DIR` or `=off`): the
+pytest-xdist workers share it, and a second run of the suite loads what the first compiled.
 """
 
 import os
@@ -14,6 +17,9 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import ddgjax  # noqa: F401, E402
+from ddgjax import compile_cache  # noqa: E402
+
+compile_cache.enable()
 
 
 def tree_max_abs_diff(a, b) -> float:

@@ -1,0 +1,60 @@
+"""JAX's persistent compilation cache, on by default for the command line and `verify`.
+
+A cold process still traces each solver, but loads the compiled program from disk instead of
+running XLA again.  The folder is `$DDGJAX_COMPILE_CACHE` when that is a path, otherwise
+`ddgjax/jax` in the user's cache directory (`$XDG_CACHE_HOME`, else `~/.cache`);
+`DDGJAX_COMPILE_CACHE=off` (or `0`, `false`, `no`) switches it off.  Library users opt in with
+`enable()` (a library does not write to the user's disk unasked).
+
+JAX keys each entry by the lowered program, the compile options and the jaxlib version, so a
+hit is the same program; the keys are stable across processes only while the traced programs
+contain no process-dependent constants (host callbacks are keyed by their registered name).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+__all__ = ["ENV", "cache_dir", "enable"]
+
+ENV = "DDGJAX_COMPILE_CACHE"
+OFF = {"off", "0", "false", "no"}
+
+
+def cache_dir(environ=os.environ) -> Path | None:
+    """The cache folder this environment asks for, or None when it is switched off."""
+    value = environ.get(ENV, "").strip()
+    if value.lower() in OFF:
+        return None
+    if value:
+        return Path(value).expanduser()
+    base = environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "ddgjax" / "jax"
+
+
+def enable(path: str | os.PathLike | None = None) -> Path | None:
+    """Switch JAX's persistent compilation cache on in this process and in processes it spawns.
+
+    `path` defaults to `cache_dir()`; returns the folder used, or None when the environment
+    switches the cache off (or the folder cannot be created: compiling without a cache is
+    always correct).  Every program is cached, however short its compilation.
+    """
+    folder = Path(path) if path is not None else cache_dir()
+    if folder is None:
+        return None
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    import jax
+
+    settings = {
+        "jax_compilation_cache_dir": str(folder),
+        "jax_persistent_cache_min_compile_time_secs": 0.0,
+        "jax_persistent_cache_min_entry_size_bytes": 0,
+    }
+    for name, value in settings.items():
+        jax.config.update(name, value)
+        os.environ[name.upper()] = str(value)  # spawned workers (`verify --jobs`) read these
+    return folder

@@ -1,0 +1,77 @@
+"""The persistent compilation cache (`ddgjax.compile_cache`): where it lives, how it is switched
+off, and that a second process loads the solver the first compiled instead of compiling it.
+
+A program hits only if its lowered text is the same in every process: the KLU analysis' address
+is therefore an argument of the solver, not a constant (`solvers/_klu.py`).  The negative control
+bakes a process-dependent constant into a program and sees it miss.
+"""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ddgjax import compile_cache
+
+PROBE = """
+import json, sys
+from jax._src import monitoring
+events = []
+monitoring.register_event_listener(lambda event, **kw: events.append(event))
+from ddgjax import compile_cache
+compile_cache.enable(sys.argv[1])
+{code}
+print(json.dumps({{"hits": events.count("/jax/compilation_cache/cache_hits"),
+                   "misses": events.count("/jax/compilation_cache/cache_misses")}}))
+"""
+
+SOLVE = """
+from energies import elastica
+from solvers import solve, KLU
+solve(elastica.clamped(12, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0)), linear_solver=KLU())
+"""
+
+PROCESS_DEPENDENT = """
+import os, jax, jax.numpy as jnp
+jax.jit(lambda x: x + os.getpid())(jnp.zeros(3)).block_until_ready()
+"""
+
+
+def cache_events(code: str, cache: Path) -> dict:
+    out = subprocess.run([sys.executable, "-c", PROBE.format(code=code), str(cache)], capture_output=True, text=True,
+                         timeout=300, env={k: v for k, v in os.environ.items() if k != compile_cache.ENV})
+    assert out.returncode == 0, out.stderr[-2000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_second_process_loads_every_compiled_program_of_a_solve(tmp_path):
+    first = cache_events(SOLVE, tmp_path)
+    second = cache_events(SOLVE, tmp_path)
+    assert first["misses"] > 0
+    assert second == {"hits": first["misses"] + first["hits"], "misses": 0}
+
+
+def test_a_process_dependent_constant_misses(tmp_path):
+    """Negative control: the probe sees misses when the program differs between processes."""
+    cache_events(PROCESS_DEPENDENT, tmp_path)
+    assert cache_events(PROCESS_DEPENDENT, tmp_path)["misses"] >= 1
+
+
+@pytest.mark.parametrize("value", ["off", "0", "False", " no "])
+def test_the_environment_switches_it_off(value):
+    assert compile_cache.cache_dir({compile_cache.ENV: value}) is None
+
+
+def test_the_folder_is_the_environment_path_or_the_user_cache(tmp_path):
+    assert compile_cache.cache_dir({compile_cache.ENV: str(tmp_path / "c")}) == tmp_path / "c"
+    assert compile_cache.cache_dir({"XDG_CACHE_HOME": str(tmp_path)}) == tmp_path / "ddgjax" / "jax"
+    assert compile_cache.cache_dir({}) == Path.home() / ".cache" / "ddgjax" / "jax"
+
+
+def test_an_unwritable_folder_leaves_the_cache_off(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert compile_cache.enable(blocker / "cache") is None
