@@ -20,7 +20,6 @@ __all__ = ["ENV", "cache_dir", "enable"]
 
 ENV = "DDGJAX_COMPILE_CACHE"
 OFF = {"off", "0", "false", "no"}
-MAX_BYTES = 2**31  # the least recently used programs are evicted beyond 2 GiB
 
 
 def cache_dir(environ=os.environ) -> Path | None:
@@ -39,8 +38,7 @@ def enable(path: str | os.PathLike | None = None) -> Path | None:
 
     `path` defaults to `cache_dir()`; returns the folder used, or None when the environment
     switches the cache off (or the folder cannot be created: compiling without a cache is
-    always correct).  Every program is cached, however short its compilation; the folder is
-    kept below `MAX_BYTES`.
+    always correct).  Every program is cached, however short its compilation.
     """
     folder = Path(path) if path is not None else cache_dir()
     if folder is None:
@@ -55,7 +53,6 @@ def enable(path: str | os.PathLike | None = None) -> Path | None:
         "jax_compilation_cache_dir": str(folder),
         "jax_persistent_cache_min_compile_time_secs": 0.0,
         "jax_persistent_cache_min_entry_size_bytes": 0,
-        "jax_compilation_cache_max_size": MAX_BYTES,
     }
     for name, value in settings.items():
         jax.config.update(name, value)
