@@ -4,11 +4,13 @@ A cold process still traces each solver, but loads the compiled program from dis
 running XLA again.  The folder is `$DDGJAX_COMPILE_CACHE` when that is a path, otherwise
 `ddgjax/jax` in the user's cache directory (`$XDG_CACHE_HOME`, else `~/.cache`);
 `DDGJAX_COMPILE_CACHE=off` (or `0`, `false`, `no`) switches it off.  Library users opt in with
-`enable()` (a library does not write to the user's disk unasked).
+`enable()` (a library does not write to the user's disk unasked).  The folder is not bounded
+(JAX's default): delete it to reclaim the space.
 
 JAX keys each entry by the lowered program, the compile options and the jaxlib version, so a
 hit is the same program; the keys are stable across processes only while the traced programs
-contain no process-dependent constants (host callbacks are keyed by their registered name).
+contain no process-dependent constants (an address, a process id).  JAX does not write programs
+with host callbacks (`SparseDirect`'s factorisations), so those compile in every process.
 """
 
 from __future__ import annotations
