@@ -247,11 +247,11 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
         m=m,
         energy_terms=energy_terms,
         constraint_terms=constraint_terms,
-        rows=(keys // size).astype(np.int32),
-        cols=(keys % size).astype(np.int32),
+        rows=device_ready(keys // size),
+        cols=device_ready(keys % size),
         hessian_target=joined["h"],
         jacobian_target=np.stack([joined["j"], joined["jt"]]),
-        diagonal=np.searchsorted(keys, diagonal).astype(np.int32),
+        diagonal=device_ready(np.searchsorted(keys, diagonal)),
         coupled=np.unique([n + r for tp in constraint_terms if tp.term.reduce == "sum" for r in tp.rows[0]]).astype(np.int64),
         key=spec.key(),
     )
@@ -371,10 +371,26 @@ def _device_index_arrays(pattern: SparsePattern) -> dict:
     split = pattern.split()
     if split is not None:
         arrays.update({f"split_{name}": getattr(split, name) for name in SPLIT_ARRAYS})
-    # `device_put`, not `jnp.asarray`: on the CPU it shares the NumPy buffer instead of copying it;
     # concrete arrays even when first made under a trace (shard_map)
     with jax.ensure_compile_time_eval():
-        return {k: jax.device_put(np.ascontiguousarray(v, dtype=np.int32)) for k, v in arrays.items()}
+        return {k: jax.device_put(device_ready(v)) for k, v in arrays.items()}
+
+
+ALIGNMENT = 64  # bytes: XLA's CPU client shares a NumPy buffer aligned so, and copies any other
+
+
+def device_ready(a: np.ndarray) -> np.ndarray:
+    """`a` as a C-contiguous int32 array whose buffer starts on a 64-byte boundary (itself if it
+    is one already), so that `jax.device_put` on the CPU shares it instead of copying it: the
+    index arrays of a 10⁵-vertex mesh are tens of MB each, held by the pattern and the solver."""
+    a = np.asarray(a)
+    if a.dtype == np.int32 and a.flags.c_contiguous and a.ctypes.data % ALIGNMENT == 0:
+        return a
+    buffer = np.empty(a.size * 4 + ALIGNMENT, np.uint8)
+    start = -buffer.ctypes.data % ALIGNMENT
+    out = buffer[start : start + a.size * 4].view(np.int32).reshape(a.shape)
+    out[...] = a
+    return out
 
 
 class PatternKey:

@@ -173,6 +173,24 @@ def test_sparse_kkt_matrix_equals_dense_hessian(monkeypatch, cells_per_chunk):
     assert np.max(np.abs(K - dense)) <= 1e-12
 
 
+def test_index_arrays_share_the_pattern_buffers():
+    """The solver's index arrays are the pattern's own buffers (64-byte aligned int32, which
+    `jax.device_put` shares on the CPU), not copies; an unaligned array would be copied."""
+    from solvers._kkt import spec_of
+    from solvers._sparse import ALIGNMENT, build_pattern, device_ready, index_arrays
+
+    problem = unit_chain(8, chord=(6.5, 3.5, 0.2))
+    pattern = build_pattern(spec_of(problem), problem.x0, problem.params)
+    index = index_arrays(pattern)
+    for name in ("rows", "cols", "diagonal"):
+        assert np.shares_memory(getattr(pattern, name), np.asarray(index[name])), name
+    assert all(v.dtype == jnp.int32 and np.asarray(v).ctypes.data % ALIGNMENT == 0 for v in index.values())
+    unaligned = np.arange(1 + 16, dtype=np.int32)[1:]  # starts 4 bytes into an aligned-or-not buffer
+    unaligned = unaligned if unaligned.ctypes.data % ALIGNMENT else np.arange(17, dtype=np.int32)[1:]
+    assert not np.shares_memory(unaligned, np.asarray(jax.device_put(unaligned)))  # negative control
+    assert np.array_equal(device_ready(unaligned), unaligned) and device_ready(unaligned).ctypes.data % ALIGNMENT == 0
+
+
 def test_auto_uses_sparse_path_for_local_problems():
     from solvers._kkt import spec_of
     from solvers._klu import KLU
