@@ -159,8 +159,7 @@ def _solve_impl(spec, linear, z0, params, lam0, weights, *, tol, max_steps, firs
         finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
         status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
 
-    kkt_final = KKT(spec, z0_, params_)
-    converged = (residual <= tol) & jnp.isfinite(kkt_final.energy(kkt_final.split(w)[0]))
+    converged = (residual <= tol) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
     status = jnp.where((status == CONVERGED) & ~converged, NONFINITE, status)
     w = implicit_solution(spec, jax.lax.stop_gradient(linear), w, z0, params, converged)
     kkt_diff = KKT(spec, z0, params)

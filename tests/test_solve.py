@@ -185,8 +185,7 @@ def test_index_arrays_share_the_pattern_buffers():
     for name in ("rows", "cols", "diagonal"):
         assert np.shares_memory(getattr(pattern, name), np.asarray(index[name])), name
     assert all(v.dtype == jnp.int32 and np.asarray(v).ctypes.data % ALIGNMENT == 0 for v in index.values())
-    unaligned = np.arange(1 + 16, dtype=np.int32)[1:]  # starts 4 bytes into an aligned-or-not buffer
-    unaligned = unaligned if unaligned.ctypes.data % ALIGNMENT else np.arange(17, dtype=np.int32)[1:]
+    unaligned = device_ready(np.arange(17))[1:]  # 4 bytes past a 64-byte boundary
     assert not np.shares_memory(unaligned, np.asarray(jax.device_put(unaligned)))  # negative control
     assert np.array_equal(device_ready(unaligned), unaligned) and device_ready(unaligned).ctypes.data % ALIGNMENT == 0
 
