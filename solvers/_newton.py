@@ -3,7 +3,7 @@
 Each step first tries the Newton step `Δ = −K⁻¹R` (with a regularisation μ = 1e-14 relative to
 each row of K, enough to factorise an exactly singular K, and one step of iterative refinement
 with the unregularised K: `LinearSolver.apply_refined`), damped `αΔ` with
-α = 1, ½, … until Deuflhard's natural monotonicity test holds (`_newton_trial`); near a
+α = 1, ½, … until Deuflhard's natural monotonicity test holds (`_step`); near a
 solution the full step is taken, so convergence is quadratic, and a quadratic program takes
 one step.
 
@@ -14,7 +14,9 @@ singular (continuous symmetries, where the solutions form a manifold), and conve
 
 The merit is the size of the residual, not the energy, so saddle points (Euler's figure-eight
 elastica) are found as readily as minima.  A minimisation problem started very far away is
-better served by `warm_start="lbfgs"`.  The loop is one `lax.while_loop`.
+better served by `warm_start="lbfgs"`.  The iteration is one `lax.while_loop` and the trials
+of a step another, with one evaluation of the residual in it: compile time grows with the
+traced graph.
 """
 
 from __future__ import annotations
@@ -56,52 +58,80 @@ def _merit(R):
     return 0.5 * jnp.dot(R, R)
 
 
-def _newton_trial(kkt: KKT, linear, K, w, R):
-    """Damped Newton step with Deuflhard's affine-covariant monotonicity test.
+class Trial(NamedTuple):
+    """The state of the trials of one step: the last damping tried (2 before the first), whether
+    the trial was the Levenberg–Marquardt one, the step, the residual there, acceptance, θ."""
 
-    With the Newton correction `Δ = −K(w)⁻¹R(w)` and, for a trial `w + αΔ`, the simplified
+    alpha: jax.Array
+    lm: jax.Array
+    d: jax.Array
+    R_new: jax.Array
+    ok: jax.Array
+    theta: jax.Array
+
+
+def _lm_direction(linear, K, R, theta, wanted):
+    """The Levenberg–Marquardt step `d = −(KᵀK + ν I)⁻¹ KᵀR`, `ν = θ|R|`, if `wanted`, else 0.
+
+    A loop that runs 0 or 1 times rather than `lax.cond`: under `vmap` a cond with a batched
+    predicate batches all its operands, incl. the sparse index arrays, which KLU cannot take
+    batched; a while_loop keeps them unbatched."""
+    nu = theta * jnp.linalg.norm(R)
+
+    def body(carry):
+        return linear.lm_solve_matrix(K, nu, R), jnp.asarray(False)
+
+    return jax.lax.while_loop(lambda carry: carry[1], body, (jnp.zeros_like(R), wanted))[0]
+
+
+def _step(kkt: KKT, linear, K, w, R, theta):
+    """One globalised step from `w`: damped Newton trials, then at most one LM trial.
+
+    Newton: with the correction `Δ = −K(w)⁻¹R(w)` and, for a trial `w + αΔ`, the simplified
     correction `Δ̄ = −K(w)⁻¹R(w + αΔ)` (same factorisation), the step is accepted when
-    `|Δ̄| ≤ (1 − α/4)|Δ|`, for the largest α in {1, ½, …, 2⁻¹⁰}.  Unlike a test on |R| this
-    does not depend on how the equations are scaled, so a start with a small residual but far
-    from the answer (a field acting on a long chain) still takes long steps.  Near a solution
-    `|Δ̄| = O(|Δ|²)` and α = 1: quadratic convergence.  Returns (α Δ, R(w + αΔ), accepted,
-    at_roundoff), the last flag saying that the Newton correction is at the round-off level of
-    w, so that a rejected step means the residual cannot be reduced further in float64.
-    `K = linear.matrix(kkt, w)`.
+    `|Δ̄| ≤ (1 − α/4)|Δ|` (Deuflhard's natural monotonicity test), for the largest α in
+    {1, ½, …, 2⁻¹⁰}.  Unlike a test on |R| this does not depend on how the equations are
+    scaled, so a start with a small residual but far from the answer (a field acting on a long
+    chain) still takes long steps.  Near a solution `|Δ̄| = O(|Δ|²)` and α = 1: quadratic
+    convergence.
+
+    If no α passes, one Levenberg–Marquardt trial `d = −(KᵀK + ν I)⁻¹ KᵀR` on the merit
+    `φ = ½|R|²`, accepted when the ratio ρ of actual to predicted decrease of φ exceeds
+    `ARMIJO`; θ grows when ρ < ¼ and shrinks when ρ > ¾ (Fan–Yuan) and after a Newton step.
+    No LM trial when the Newton correction is at the round-off level of w: the residual cannot
+    be reduced further in float64 (`stuck`).
+
+    All trials are one loop with one evaluation of the residual, so the compiled program holds
+    the residual once.  Returns `(d, R(w + d), accepted, θ, stuck)`; `K = linear.matrix(kkt, w)`.
     """
     fac = linear.factor_matrix(kkt, K, NEWTON_MU)
     delta = linear.apply_refined(fac, K, -R)
     size = jnp.linalg.norm(delta)
-
-    def cond(carry):
-        alpha, _, ok = carry
-        return (~ok) & (alpha > MIN_NEWTON_STEP)
-
-    def body(carry):
-        # one trace of the trial (the loop starts at α = 2, so that its first trial is α = 1)
-        alpha = 0.5 * carry[0]
-        R_new = kkt.residual(w + alpha * delta)
-        simplified = jnp.linalg.norm(linear.apply(fac, -R_new))
-        ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & (simplified <= (1 - alpha / 4) * size)
-        return alpha, R_new, ok
-
-    start = (jnp.asarray(2.0, w.dtype), R, jnp.asarray(False))
-    alpha, R_new, ok = jax.lax.while_loop(cond, body, start)
     at_roundoff = jnp.max(jnp.abs(delta)) <= ROUNDOFF * jnp.maximum(1.0, jnp.max(jnp.abs(w)))
-    return alpha * delta, R_new, ok & jnp.isfinite(size), at_roundoff
 
+    def cond(t: Trial):
+        newton_left = (t.alpha > MIN_NEWTON_STEP) | ~at_roundoff
+        return ~t.ok & ~t.lm & newton_left
 
-def _lm_trial(kkt: KKT, linear, K, w, R, theta):
-    """One Levenberg–Marquardt trial; returns the step, new residual, acceptance and new θ."""
-    nu = theta * jnp.linalg.norm(R)
-    d = linear.lm_solve_matrix(K, nu, R)
-    R_new = kkt.residual(w + d)
-    predicted = _merit(R) - _merit(R + linear.matvec(K, d))
-    actual = _merit(R) - _merit(R_new)
-    rho = jnp.where(predicted > 0, actual / predicted, -1.0)
-    rho = jnp.where(jnp.isfinite(rho) & jnp.all(jnp.isfinite(d)), rho, -1.0)
-    theta = jnp.where(rho < 0.25, 4.0 * theta, jnp.where(rho > 0.75, jnp.maximum(theta / 4, THETA_MIN), theta))
-    return d, R_new, rho > ARMIJO, theta
+    def body(t: Trial) -> Trial:
+        alpha = 0.5 * t.alpha  # the first trial is α = 1; after 2⁻¹⁰, the LM trial
+        lm = alpha < MIN_NEWTON_STEP
+        d = jnp.where(lm, _lm_direction(linear, K, R, t.theta, lm), alpha * delta)
+        R_new = kkt.residual(w + d)
+        simplified = jnp.linalg.norm(linear.apply(fac, -R_new))
+        newton_ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & jnp.isfinite(size)
+        newton_ok = newton_ok & (simplified <= (1 - alpha / 4) * size)
+        predicted = _merit(R) - _merit(R + linear.matvec(K, d))
+        rho = jnp.where(predicted > 0, (_merit(R) - _merit(R_new)) / predicted, -1.0)
+        rho = jnp.where(jnp.isfinite(rho) & jnp.all(jnp.isfinite(d)), rho, -1.0)
+        theta_lm = jnp.where(rho < 0.25, 4.0 * t.theta, jnp.where(rho > 0.75, jnp.maximum(t.theta / 4, THETA_MIN), t.theta))
+        ok = jnp.where(lm, rho > ARMIJO, newton_ok)
+        theta = jnp.where(lm, theta_lm, jnp.where(ok, jnp.maximum(t.theta / 4, THETA_MIN), t.theta))
+        return Trial(alpha, lm, d, R_new, ok, theta)
+
+    false = jnp.asarray(False)
+    t = jax.lax.while_loop(cond, body, Trial(jnp.asarray(2.0, w.dtype), false, jnp.zeros_like(w), R, false, theta))
+    return t.d, t.R_new, t.ok, t.theta, ~t.ok & ~t.lm & at_roundoff
 
 
 def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
@@ -119,20 +149,7 @@ def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> Newt
 
     def body(s: NewtonState) -> NewtonState:
         K = linear.matrix(kkt, s.w)  # the second derivatives, once per step
-        d, R_new, ok, at_roundoff = _newton_trial(kkt, linear, K, s.w, s.R)
-        theta = jnp.where(ok, jnp.maximum(s.theta / 4, THETA_MIN), s.theta)
-        stuck = (~ok) & at_roundoff
-
-        # "if not ok: LM trial", written as a loop that runs 0 or 1 times rather than lax.cond:
-        # under vmap a cond with a batched predicate batches all its operands, incl. the
-        # sparse index arrays, which KLU cannot take batched; a while_loop keeps them unbatched.
-        def lm_cond(carry):
-            return ~carry[4] & ~stuck
-
-        def lm_body(carry):
-            return _lm_trial(kkt, linear, K, s.w, s.R, carry[3]) + (jnp.asarray(True),)
-
-        d, R_new, ok, theta, _ = jax.lax.while_loop(lm_cond, lm_body, (d, R_new, ok, theta, ok))
+        d, R_new, ok, theta, stuck = _step(kkt, linear, K, s.w, s.R, s.theta)
         w = jnp.where(ok, s.w + d, s.w)
         R = jnp.where(ok, R_new, s.R)
         residual = scaled_residual(R, weights, n)
