@@ -143,6 +143,8 @@ def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> Newt
     finite = jnp.isfinite(res0) & jnp.isfinite(kkt.energy(kkt.split(w0)[0]))
     status0 = jnp.where(finite, jnp.where(res0 <= tol, CONVERGED, go_on), NONFINITE)
     state = NewtonState(w0, R0, res0, jnp.asarray(THETA_START), jnp.asarray(0), history, status0)
+    if max_steps == 0:  # the KKT residual at w0 only: no second derivatives, no linear solver in the program
+        return state
 
     def cond(s: NewtonState):
         return s.status == RUNNING

@@ -3,7 +3,9 @@ off, and that a second process loads the solver the first compiled instead of co
 
 A program hits only if its lowered text is the same in every process: the KLU analysis' address
 is therefore an argument of the solver, not a constant (`solvers/_klu.py`).  The negative control
-bakes a process-dependent constant into a program and sees it miss.
+bakes a process-dependent constant into a program and sees it miss.  Programs with host callbacks
+(the `SparseDirect` factorisations) are never cached: they neither hit nor miss, they compile
+(`compiles` counts XLA's compilations).
 """
 
 import json
@@ -18,14 +20,20 @@ from ddgjax import compile_cache
 
 PROBE = """
 import json, sys
-from jax._src import monitoring
+from jax._src import compiler, monitoring
 events = []
 monitoring.register_event_listener(lambda event, **kw: events.append(event))
+_compile = compiler.backend_compile_and_load
+def counted(*args, **kwargs):
+    events.append("compile")
+    return _compile(*args, **kwargs)
+compiler.backend_compile_and_load = counted
 from ddgjax import compile_cache
 compile_cache.enable(sys.argv[1])
 {code}
 print(json.dumps({{"hits": events.count("/jax/compilation_cache/cache_hits"),
-                   "misses": events.count("/jax/compilation_cache/cache_misses")}}))
+                   "misses": events.count("/jax/compilation_cache/cache_misses"),
+                   "compiles": events.count("compile")}}))
 """
 
 SOLVE = """
@@ -51,7 +59,7 @@ def test_a_second_process_loads_every_compiled_program_of_a_solve(tmp_path):
     first = cache_events(SOLVE, tmp_path)
     second = cache_events(SOLVE, tmp_path)
     assert first["misses"] > 0
-    assert second == {"hits": first["misses"] + first["hits"], "misses": 0}
+    assert second == {"hits": first["misses"] + first["hits"], "misses": 0, "compiles": 0}
 
 
 def test_a_process_dependent_constant_misses(tmp_path):
@@ -75,3 +83,24 @@ def test_an_unwritable_folder_leaves_the_cache_off(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("")
     assert compile_cache.enable(blocker / "cache") is None
+
+
+
+STEPS = """
+import ddgjax as dg
+from energies import area
+from solvers import solve, SparseDirect
+V, F = dg.mesh.disk(1, 6)
+solve(area.simplicial(V + [0, 0, 0.1] * (V[:, :1] > 0), F), linear_solver=SparseDirect(), max_steps={steps}, throw=False)
+"""
+
+
+@pytest.mark.parametrize("steps", [0, 1])
+def test_a_solve_without_steps_has_no_host_callback_and_is_loaded_from_the_cache(tmp_path, steps):
+    """`max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
+    factorisation, so no host callback, which JAX never caches: a second process loads it all.
+    Control: with a Newton step the `SparseDirect` solver calls the host, and compiles again."""
+    cache_events(STEPS.format(steps=steps), tmp_path)
+    second = cache_events(STEPS.format(steps=steps), tmp_path)
+    assert second["misses"] == 0
+    assert (second["compiles"] == 0) == (steps == 0)
