@@ -22,10 +22,11 @@ from ._direct import SparseDirect, default_factoriser
 from ._klu import KLU
 from ._krylov import Krylov
 from ._linear import LinearSolver
-from ._newton import CONVERGED, NONFINITE, STATUS_TEXT, newton
+from ._newton import CONVERGED, MAX_STEPS, NONFINITE, STALLED, STATUS_TEXT, newton
 from ._sparse import cached_pattern
 
 METHODS = ("auto", "dense", "sparse", "krylov", "lbfgs")
+WARM_STARTS = ("auto", "lbfgs", None)
 FIRST_ORDER_OUTER = 50
 
 
@@ -178,7 +179,7 @@ def solve(
     linear_solver: LinearSolver | None = None,
     throw: bool = True,
     multipliers0=None,
-    warm_start: str | None = None,
+    warm_start: str | None = "auto",
 ) -> Solution:
     """Find a critical point of `problem.energy` on `problem.constraints == 0`.
 
@@ -205,8 +206,13 @@ def solve(
       problem). With `throw=False` check `Solution.converged`.
     - `multipliers0`: starting multipliers, flat or named like `Solution.multipliers` (default:
       least squares `argmin |∇E − Jᵀλ|` at x0).
-    - `warm_start="lbfgs"`: run up to 50 augmented-Lagrangian L-BFGS steps before Newton, for
-      minimisation problems started far away.
+    - `warm_start`: `"lbfgs"` runs up to 50 augmented-Lagrangian L-BFGS steps before Newton, for
+      minimisation problems started far away; `"auto"` (default) runs Newton from x0 and, only if
+      that stops without converging (max_steps reached or stalled, not a non-finite start),
+      solves once more from x0 with the L-BFGS phase first and returns that solution if it
+      converged (outside `jit`/`vmap`/`grad`, where values are concrete; Newton's merit |R|² has
+      local minima that are not solutions, which the augmented Lagrangian escapes); `None`:
+      Newton alone.  The retry finds minima, not saddles.
 
     **Returns:** a `Solution`. Derivatives of functions of `.x`, `.multipliers`, `.energy` with
     respect to `problem.params` (and `x0`'s fixed entries) are exact (implicit function theorem),
@@ -220,8 +226,8 @@ def solve(
     """
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
-    if warm_start not in (None, "lbfgs"):
-        raise InvalidInputError(f"warm_start must be None or 'lbfgs', got {warm_start!r}")
+    if warm_start not in WARM_STARTS:
+        raise InvalidInputError(f"warm_start must be one of {WARM_STARTS}, got {warm_start!r}")
     check_positive(tol, "tol")
     if int(max_steps) < 0:
         raise InvalidInputError(f"max_steps must be >= 0, got {max_steps}")
@@ -233,14 +239,20 @@ def solve(
     z0 = spec.layout.ravel(problem.x0)
     lam0 = None if lam0 is None else lam0.astype(z0.dtype)
     first_order = FIRST_ORDER_OUTER if warm_start == "lbfgs" else (int(max_steps) if method == "lbfgs" else 0)
+    weights = residual_weights(problem, spec)
+
+    def run(first_order: int) -> Solution:
+        return _solve_jit(spec, linear, z0, problem.params, lam0, weights, tol=float(tol), max_steps=int(max_steps),
+                          first_order=first_order, newton_phase=method != "lbfgs")
+
     try:
-        sol = _solve_jit(
-            spec, linear, z0, problem.params, lam0, residual_weights(problem, spec),
-            tol=float(tol), max_steps=int(max_steps), first_order=first_order, newton_phase=method != "lbfgs",
-        )
+        sol = run(first_order)
         if not is_concrete(sol):
             return _raise_if_not_converged(problem, sol) if throw else sol
         jax.block_until_ready(sol)  # a failure in the computation surfaces here, not later
+        if warm_start == "auto" and method != "lbfgs" and int(sol.status) in (MAX_STEPS, STALLED):
+            retry = run(FIRST_ORDER_OUTER)
+            sol = retry if bool(retry.converged) else sol
     except jax.errors.JaxRuntimeError as err:  # KLU and the host factorisations report a singular matrix so
         raise ConvergenceError(
             f"{_label(problem)}the sparse linear solve failed ({_first_line(err)}); try method='dense' to diagnose",
@@ -281,8 +293,7 @@ def _finish(problem: Problem, sol: Solution, throw: bool, tol: float) -> Solutio
                  if status == NONFINITE else f"with KKT residual {float(sol.residual):.3e} > tol {tol:.1e}")
         raise ConvergenceError(
             f"{_label(problem)}solve did not converge: {STATUS_TEXT.get(status, status)} after {steps} "
-            f"steps {where}. Try a better x0, "
-            "warm_start='lbfgs' (for minimisation), a larger max_steps, or a looser tol.",
+            f"steps {where}. Try a better x0, a larger max_steps, or a looser tol.",
             residual=float(sol.residual), steps=steps, solution=sol,
         )
     return sol

@@ -6,6 +6,9 @@
 - Newton's step count does not grow with the resolution: a cantilever of unit tangents under a
   tip load (bending `Σ |T_{k+1} − T_k|²/h`, Def 3.2 to second order, and the load's potential
   `−⟨F, γ_n⟩ = −h Σ ⟨F, T_k⟩`).
+- A start Newton alone cannot leave: a clamped elastica whose chord leaves the plane of the end
+  tangents slightly.  Newton's merit |R|² stalls at a local minimum that is no solution; the
+  default `warm_start="auto"` then solves again after the augmented-Lagrangian L-BFGS phase.
 - Ill-conditioned problems: the regularisation is scaled row by row and the Newton step refined
   once with the unregularised K (`solvers/_linear.py`), so a diagonal quadratic with condition
   number 10¹⁴ or 10¹⁶ is solved in one step.
@@ -155,6 +158,25 @@ def test_cantilever_newton_steps_do_not_grow_with_n(start):
 def test_cantilever_newton_steps_at_n_2048():
     steps = cantilever_steps((16, 2048))
     assert max(steps) <= 2 * min(steps) and max(steps) <= 8, steps
+
+
+# --- a start Newton alone cannot leave ------------------------------------------------------
+
+
+@pytest.mark.parametrize("z", [0.02, 0.1])
+def test_slightly_non_planar_elastica_converges_with_the_default_call(z):
+    """Def 3.2 with the chord (0.5, 0.2, z) and T_0 = e1, T_15 = e2: the solution is a critical
+    point (KKT residual), on the constraints (|T_k| = 1, h Σ T_k = chord) to round-off.
+    Negative control: Newton alone (`warm_start=None`) stops without converging."""
+    chord = np.array([0.5, 0.2, z])
+    problem = elastica.clamped(16, chord=chord, t_start=E1, t_end=(0.0, 1.0, 0.0))
+    sol = solve(problem)
+    T = np.asarray(sol.x)
+    assert float(sol.residual) <= 1e-10
+    assert np.max(np.abs(np.linalg.norm(T, axis=1) - 1.0)) <= 1e-10
+    assert np.max(np.abs(T.sum(axis=0) / 16 - chord)) <= 1e-10
+    with pytest.raises(dg.errors.ConvergenceError, match="did not converge"):
+        solve(problem, warm_start=None)
 
 
 # --- ill-conditioned problems --------------------------------------------------------------
