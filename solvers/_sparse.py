@@ -47,7 +47,8 @@ class SparsePattern:
     constraint_terms: tuple[TermPattern, ...]
     rows: np.ndarray  # (nnz,) int32, coalesced COO rows of the KKT matrix
     cols: np.ndarray  # (nnz,) int32
-    hessian_target: np.ndarray  # (n_hessian_raw,) int32: coalesced entry of each raw Hessian value (nnz: dropped)
+    hessian_targets: tuple[np.ndarray, ...]  # per Hessian term (chunks, cells per chunk, sd²) int32, 64-byte
+    #   aligned (`in_chunks` order): the coalesced entry of each raw Hessian value (nnz: dropped, and padding)
     jacobian_target: np.ndarray  # (2, n_jacobian_raw) int32: entries of each raw Jacobian value in −J and −Jᵀ
     diagonal: np.ndarray  # (n + m,) int32: the diagonal entries
     coupled: np.ndarray  # KKT indices of the multipliers of global sums (e.g. a chord)
@@ -181,10 +182,10 @@ this many integers instead of several times the number of raw entries (16·10⁶
 
 def _raw_entries(terms_h, terms_j, free_of: np.ndarray, n: int, size: int):
     """The raw KKT entries, term by term and cell by cell, in chunks of about `RAW_PER_CHUNK`:
-    `(kind, count, kept, key)`: `count` raw values of `kind` ("h": Hessian, "j": −J, "jt": −Jᵀ,
-    each in its own order), of which those at `kept` add to a free entry with key row·size + col
-    (entries on fixed unknowns are dropped)."""
-    for tp in terms_h:  # Hessian blocks: every (row, col) pair of a cell's columns
+    `(kind, term, count, kept, key)`: `count` raw values of `kind` ("h": Hessian of `terms_h[term]`,
+    "j": −J, "jt": −Jᵀ, each in its own order), of which those at `kept` add to a free entry with
+    key row·size + col (entries on fixed unknowns are dropped)."""
+    for i, tp in enumerate(terms_h):  # Hessian blocks: every (row, col) pair of a cell's columns
         K, sd = tp.columns.shape
         step = max(1, RAW_PER_CHUNK // (sd * sd))
         for k0 in range(0, K, step):
@@ -192,7 +193,7 @@ def _raw_entries(terms_h, terms_j, free_of: np.ndarray, n: int, size: int):
             fr = np.repeat(cols, sd, axis=1).ravel()
             fc = np.tile(cols, (1, sd)).ravel()
             kept = np.flatnonzero((fr >= 0) & (fc >= 0))
-            yield "h", fr.size, kept, fr[kept] * size + fc[kept]
+            yield "h", i, fr.size, kept, fr[kept] * size + fc[kept]
     for tp in terms_j:  # Jacobian blocks, stored once, used for −J (rows n + r) and −Jᵀ
         K, sd = tp.columns.shape
         c = tp.rows.shape[1]
@@ -202,8 +203,8 @@ def _raw_entries(terms_h, terms_j, free_of: np.ndarray, n: int, size: int):
             rr = n + np.repeat(tp.rows[k0 : k0 + step], sd, axis=1).ravel()
             fc = free_of[np.broadcast_to(tp.columns[k0 : k0 + step, None, :], (kc, c, sd))].ravel()
             kept = np.flatnonzero(fc >= 0)
-            yield "j", fc.size, kept, rr[kept] * size + fc[kept]
-            yield "jt", fc.size, kept, fc[kept] * size + rr[kept]
+            yield "j", None, fc.size, kept, rr[kept] * size + fc[kept]
+            yield "jt", None, fc.size, kept, fc[kept] * size + rr[kept]
 
 
 def _distinct(a: np.ndarray) -> np.ndarray:
@@ -217,7 +218,9 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
 
     Two passes over the raw entries in chunks: the sorted distinct keys (row·size + col, the
     diagonal included), then each raw entry's position among them (`searchsorted`), or nnz for
-    an entry on a fixed unknown (a slot that `kkt_values` drops).
+    an entry on a fixed unknown (a slot that `kkt_values` drops).  The Hessian's positions are
+    written straight into their chunked, device-ready arrays (`_hessian_chunks`): at 10⁵
+    vertices they are 16·10⁶ integers, which exist once.
     """
     shape = spec.layout.shapes[0]
     width = shape[1] if len(shape) == 2 else 1
@@ -236,11 +239,19 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
 
     diagonal = np.arange(size, dtype=np.int64) * (size + 1)
     keys = _distinct(np.concatenate([_distinct(key) for *_, key in entries()] + [diagonal]))
-    targets = {"h": [], "j": [], "jt": []}
-    for kind, count, kept, key in entries():
+    hessian_targets = tuple(in_chunks_empty(tp.columns.shape[0], chunk_count(tp.columns.shape[0]),
+                                            (tp.columns.shape[1] ** 2,), fill=keys.size)
+                            for tp in energy_terms + constraint_terms)
+    written = [0] * len(hessian_targets)
+    targets = {"j": [], "jt": []}
+    for kind, term, count, kept, key in entries():
         target = np.full(count, keys.size, dtype=np.int32)
         target[kept] = np.searchsorted(keys, key)
-        targets[kind].append(target)
+        if kind == "h":
+            hessian_targets[term].reshape(-1)[written[term] : written[term] + count] = target
+            written[term] += count
+        else:
+            targets[kind].append(target)
     joined = {kind: np.concatenate(t) if t else np.zeros((0,), np.int32) for kind, t in targets.items()}
     return SparsePattern(
         n=n,
@@ -249,7 +260,7 @@ def build_pattern(spec: Spec, x0, params) -> SparsePattern:
         constraint_terms=constraint_terms,
         rows=device_ready(keys // size),
         cols=device_ready(keys % size),
-        hessian_target=joined["h"],
+        hessian_targets=hessian_targets,
         jacobian_target=np.stack([joined["j"], joined["jt"]]),
         diagonal=device_ready(np.searchsorted(keys, diagonal)),
         coupled=np.unique([n + r for tp in constraint_terms if tp.term.reduce == "sum" for r in tp.rows[0]]).astype(np.int64),
@@ -276,6 +287,14 @@ def chunk_count(cells: int) -> int:
     return max(1, -(-cells // CELLS_PER_CHUNK))
 
 
+def in_chunks_empty(cells: int, chunks: int, shape: tuple, fill: int) -> np.ndarray:
+    """A device-ready int32 array (chunks, ⌈cells / chunks⌉, *shape) laid out as `in_chunks`
+    lays out `cells` rows, every entry `fill` (to be overwritten by the first `cells` rows)."""
+    out = aligned_int32((chunks, -(-cells // chunks)) + tuple(shape))
+    out.fill(fill)
+    return out
+
+
 def in_chunks(a: np.ndarray, chunks: int, fill) -> np.ndarray:
     """(K, ...) → (chunks, ⌈K / chunks⌉, ...): consecutive cells, the last chunk padded with `fill`."""
     size = -(-len(a) // chunks)
@@ -286,16 +305,13 @@ def in_chunks(a: np.ndarray, chunks: int, fill) -> np.ndarray:
 def _hessian_chunks(pattern: SparsePattern) -> dict:
     """Per Hessian term i: its cells' stencils, constraint rows and entries in chunks
     (`cells_i`, `rows_i`, `targets_i`); padding cells read row 0 and add to the dropped slot."""
-    arrays, offset = {}, 0
+    arrays = {}
     for i, tp in enumerate(pattern.energy_terms + pattern.constraint_terms):
-        K, sd = tp.columns.shape
-        chunks = chunk_count(K)
-        targets = pattern.hessian_target[offset : offset + K * sd * sd].reshape(K, sd * sd)
+        chunks = chunk_count(tp.columns.shape[0])
         arrays[f"cells_{i}"] = in_chunks(tp.term.stencil, chunks, 0)
-        arrays[f"targets_{i}"] = in_chunks(targets, chunks, pattern.nnz)
+        arrays[f"targets_{i}"] = pattern.hessian_targets[i]
         if tp.rows is not None:
             arrays[f"rows_{i}"] = in_chunks(tp.rows, chunks, 0)
-        offset += K * sd * sd
     return arrays
 
 
@@ -386,11 +402,17 @@ def device_ready(a: np.ndarray) -> np.ndarray:
     a = np.asarray(a)
     if a.dtype == np.int32 and a.flags.c_contiguous and a.ctypes.data % ALIGNMENT == 0:
         return a
-    buffer = np.empty(a.size * 4 + ALIGNMENT, np.uint8)
-    start = -buffer.ctypes.data % ALIGNMENT
-    out = buffer[start : start + a.size * 4].view(np.int32).reshape(a.shape)
+    out = aligned_int32(a.shape)
     out[...] = a
     return out
+
+
+def aligned_int32(shape: tuple) -> np.ndarray:
+    """An uninitialised C-contiguous int32 array of `shape` starting on a 64-byte boundary."""
+    size = int(np.prod(shape, dtype=np.int64))
+    buffer = np.empty(size * 4 + ALIGNMENT, np.uint8)
+    start = -buffer.ctypes.data % ALIGNMENT
+    return buffer[start : start + size * 4].view(np.int32).reshape(shape)
 
 
 class PatternKey:
