@@ -81,11 +81,19 @@ def is_chain(problem: Problem, spec: Spec) -> bool:
     return derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width)) is not None
 
 
+KLU_MAX = 500
+"""Unknowns + multipliers up to which `method="sparse"` takes KLU on meshes too.  Measured on the
+saddle grids of `benchmarks/scale.py` (s per Newton step, KLU vs Pardiso): N = 432: 3.4 vs 4.5 ms,
+N = 588: 5.8 vs 5.3 ms, N = 972: 9.0 vs 6.7 ms.  KLU's solvers are also kept by the persistent
+compilation cache, Pardiso's host callbacks are not."""
+
+
 def sparse_direct_for(problem: Problem, spec: Spec) -> LinearSolver:
-    """`method="sparse"`: KLU for chains (banded, no fill: KLU is fastest there), the
-    fill-reducing `SparseDirect` with Pardiso (or CHOLMOD) otherwise (meshes; KLU where neither
-    is installed: SuperLU, the remaining factoriser, is slower than KLU there)."""
-    if is_chain(problem, spec) or default_factoriser() is None:
+    """`method="sparse"`: KLU for chains (banded, no fill: KLU is fastest there) and for small
+    problems (N = n + m ≤ `KLU_MAX`), the fill-reducing `SparseDirect` with Pardiso (or CHOLMOD)
+    otherwise (meshes; KLU where neither is installed: SuperLU, the remaining factoriser, is
+    slower than KLU there)."""
+    if spec.n + spec.m <= KLU_MAX or default_factoriser() is None or is_chain(problem, spec):
         return KLU()
     return SparseDirect()
 
