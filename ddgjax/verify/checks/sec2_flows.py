@@ -31,10 +31,17 @@ def closed_curve(n: int):
     return jnp.asarray(gamma) / eps, eps, np.asarray(s)
 
 
-def _edge_length_rate(flow, gamma) -> float:
-    """max_k |d/dt |γ_{k+1} − γ_k|²| along ∂_t γ = flow(γ) (a JVP)."""
+def _length_rates(gamma, fields) -> np.ndarray:
+    """`(edges, m)`: column j is d/dt |γ_{k+1} − γ_k|² = 2<u_{k+1} − u_k, Δγ_k> (2.5) along the
+    velocity field u = fields[j] (m, N, 3) of the closed curve γ: the rigidity matrix (the
+    Jacobian of the squared edge lengths, by autodiff) applied to the fields."""
     squared = lambda g: curves.edge_lengths(g, closed=True) ** 2  # noqa: E731
-    return float(jnp.max(jnp.abs(jax.jvp(squared, (gamma,), (flow(gamma, closed=True),))[1])))
+    return np.einsum("eni,mni->em", np.asarray(jax.jacfwd(squared)(gamma)), np.asarray(fields))
+
+
+def _edge_length_rate(flow, gamma) -> float:
+    """max_k |d/dt |γ_{k+1} − γ_k|²| along ∂_t γ = flow(γ)."""
+    return float(np.max(np.abs(_length_rates(gamma, flow(gamma, closed=True)[None]))))
 
 
 @check("Prop 2.1", "the discrete tangent flow keeps every edge length (autodiff of the bending energy)",
@@ -60,12 +67,17 @@ def heisenberg_commutes_with_tangent_flow(ctx, n):
        quantity="max_k |∂_t T_k − (∇_k H × T_k)|", at_most=1e-13, quick=dict(n=24))
 def heisenberg_flow_on_tangents_is_spin_chain(ctx, n):
     gamma = closed_curve(n)[0]
-    edges = functools.partial(curves.edge_vectors, closed=True)
-    dT = jax.jvp(edges, (gamma,), (curves.heisenberg_flow(gamma),))[1]
-    return float(jnp.max(jnp.abs(dT - heisenberg.flow("integrable", -0.5)(edges(gamma)))))
+    dT = _tangents_moved_by(curves.heisenberg_flow, gamma)
+    return float(jnp.max(jnp.abs(dT - heisenberg.flow("integrable", -0.5)(curves.edge_vectors(gamma, closed=True)))))
 
 
 _heisenberg_flow = jax.jit(curves.heisenberg_flow)  # one compilation per n, not one per operation
+
+
+def _tangents_moved_by(flow, gamma):
+    """`∂_t T_k = ∂_t Δγ_k = Δ(∂_t γ)_k` (unit edges; Δ is linear) along ∂_t γ = flow(γ): (N, 3),
+    one per edge."""
+    return curves.edge_vectors(flow(gamma), closed=True)
 
 
 @jax.jit
@@ -98,3 +110,147 @@ def bending_energy_smooth_limit(ctx, ns):
 
     table = dg.limits.convergence(error, ns, label="error of (4/ε) Σ E_k")
     return ctx.convergence(table, "convergence_bending_energy").fitted_order
+
+
+# --- uniqueness in Prop 2.1 and Prop 2.2: the kernel of a linear map on per-vertex coefficients --
+
+KERNEL_TOL = 1e-10  # singular values below this times the largest span the kernel
+
+
+def _per_vertex(X) -> np.ndarray:
+    """The fields `e_j ⊗ X_j` (N, N, 3): field j is X_j at vertex j and 0 elsewhere, so that the
+    flow `Σ_j α_j (e_j ⊗ X_j)` is `u_k = α_k X_k`."""
+    X = np.asarray(X)
+    return np.eye(len(X))[:, :, None] * X[None]
+
+
+def _kernel_defect(M, coefficients) -> float:
+    """`|dim ker M − 1| + dist(ĉ, ker M)` with ĉ = c/|c|: zero iff the kernel of M is the line
+    spanned by the coefficients c (numerical kernel: singular values ≤ KERNEL_TOL σ_max)."""
+    M = np.asarray(M)
+    _, sigma, Vt = np.linalg.svd(M)
+    sigma = np.concatenate([sigma, np.zeros(M.shape[1] - len(sigma))])
+    kernel = Vt[sigma <= KERNEL_TOL * sigma[0]]
+    c = np.asarray(coefficients) / np.linalg.norm(coefficients)
+    return abs(len(kernel) - 1) + float(np.linalg.norm(c - kernel.T @ (kernel @ c)))
+
+
+def _vertex_pairs(gamma):
+    """`(T_{k−1}, T_k)` at every vertex of the closed unit-edge curve γ (numpy)."""
+    T = np.asarray(curves.tangents(gamma, closed=True))
+    return np.roll(T, 1, axis=0), T
+
+
+def _components(u, X) -> tuple[np.ndarray, float]:
+    """`(α, max_k |u_k − α_k X_k|)` with α_k = <u_k, X_k>/|X_k|²: the coefficients of the vertex
+    field u in the family α_k X_k, and how far u is from the family."""
+    u, X = np.asarray(u), np.asarray(X)
+    alpha = np.sum(u * X, axis=1) / np.sum(X * X, axis=1)
+    return alpha, float(np.max(np.abs(u - alpha[:, None] * X)))
+
+
+def _tangent_family_defect(n: int, weight: float) -> tuple[float, np.ndarray]:
+    """Kernel defect of α ↦ (d/dt |Δγ_k|²)_k on the flows α_k (T_k + weight·T_{k−1}) against the
+    library's tangent flow; and the singular values of the map."""
+    gamma = closed_curve(n)[0]
+    T_prev, T = _vertex_pairs(gamma)
+    M = _length_rates(gamma, _per_vertex(T + weight * T_prev))
+    alpha, off_family = _components(curves.tangent_flow(gamma), T + T_prev)
+    return _kernel_defect(M, alpha) + off_family, np.linalg.svd(M, compute_uv=False)
+
+
+@check("Prop 2.1", "uniqueness: among the flows α_k (T_k + T_(k−1)), α ∈ R^N, those keeping every edge "
+       "length form one line, spanned by the coefficients 1/(1 + <T_k, T_(k−1)>) of the tangent flow",
+       quantity="|dim ker − 1| + dist(α_lib/|α_lib|, ker) + |v − α_lib (T_k + T_(k−1))| "
+       "(ker of α ↦ d/dt|Δγ|², SVD)",
+       at_most=1e-12, quick=dict(n=24))
+def tangent_flow_is_unique(ctx, n):
+    """Proof of Prop 2.1: for u_k = α_k (T_k + T_(k−1)), (2.5) gives d/dt |Δγ_k|²/2 = c_(k+1) − c_k with
+    c_k = α_k (1 + <T_k, T_(k−1)>); on a closed curve the kernel is c = const, i.e. α ∝ 1/(1 + <T_k, T_(k−1)>).
+    Here the map α ↦ d/dt |Δγ|² is built by autodiff (no formula typed in) and its kernel found by SVD."""
+    return _tangent_family_defect(n, 1.0)[0]
+
+
+@check("Prop 2.1", "negative control: in the family α_k (T_k + ½T_(k−1)) (not the bisector) no flow keeps "
+       "the lengths of a closed curve: the rate map is invertible",
+       quantity="σ_min / σ_max of α ↦ d/dt|Δγ|²", at_least=1e-3, quick=dict(n=24))
+def skewed_tangent_family_has_no_length_preserving_flow(ctx, n):
+    """c_(k+1)/c_k is no longer 1 but a ratio of two different factors, whose product round the closed curve is
+    not 1: the kernel is trivial.  Fails if the rate map were blind to the direction of the family."""
+    sigma = _tangent_family_defect(n, 0.5)[1]
+    return float(sigma[-1] / sigma[0])
+
+
+def _binormals(gamma):
+    """`T_k × T_{k−1}` at every vertex of the closed unit-edge curve γ (traceable)."""
+    E = curves.edge_vectors(gamma, closed=True)
+    return jnp.cross(E, jnp.roll(E, 1, axis=0))
+
+
+@functools.cache
+def _commutator_map(n: int) -> np.ndarray:
+    """`(2N, N)`: β ↦ (<[v, w_β], T_k>, <[v, w_β], T_(k−1)>)_k for the binormal flows
+    w_β = β_k T_k × T_(k−1) and the tangent flow v.  These components do not see how β_k
+    varies with the curve (its derivative multiplies T_k × T_(k−1)), so the map is linear in the
+    values β_k: the equations (2.10) = (2.11) of the proof of Prop 2.2 and their T_(k−1) analogue."""
+    gamma = closed_curve(n)[0]
+    v, B = curves.tangent_flow(gamma), np.asarray(_binormals(gamma))
+    dB_v = np.asarray(jax.jvp(_binormals, (gamma,), (v,))[1])
+    Dv = np.asarray(jax.jacfwd(curves.tangent_flow)(gamma))  # (k, i, j, l): ∂v_(k,i)/∂γ_(j,l)
+    # [v, e_j ⊗ B_j] = D(e_j ⊗ B_j)·v − Dv·(e_j ⊗ B_j), the convention of dg.lie_bracket
+    brackets = _per_vertex(dB_v) - np.einsum("kijl,jl->jki", Dv, B)  # (β_j, vertex k, 3)
+    T_prev, T = _vertex_pairs(gamma)
+    return np.concatenate([np.einsum("jki,ki->kj", brackets, T), np.einsum("jki,ki->kj", brackets, T_prev)])
+
+
+@check("Prop 2.2", "uniqueness: every binormal flow β_k T_k × T_(k−1) keeps the edge lengths, and those "
+       "commuting with the tangent flow form one line, spanned by the coefficients 1/(1 + <T_k, T_(k−1)>) of "
+       "the Heisenberg flow",
+       quantity="|dim ker − 1| + dist(β_lib/|β_lib|, ker) + |w − β_lib T_k × T_(k−1)| "
+       "+ max |d/dt|Δγ|²| over the family",
+       at_most=1e-12, quick=dict(n=24))
+def heisenberg_flow_is_unique(ctx, n):
+    """Prop 2.2: keeping lengths does not single out a binormal flow ((2.5): every w_k ⊥ T_k, T_(k−1)); commuting
+    with the tangent flow does.  (2.10) = (2.11) gives β_k (1 + <T_k, T_(k−1)>) = β_(k+1) (1 + <T_(k+1), T_k>):
+    the kernel of the commutator map is the line of β_k = 1/(1 + <T_k, T_(k−1)>), the coefficients of (2.9)."""
+    gamma = closed_curve(n)[0]
+    B = np.asarray(_binormals(gamma))
+    beta, off_family = _components(curves.heisenberg_flow(gamma), B)
+    lengths_kept = float(np.max(np.abs(_length_rates(gamma, _per_vertex(B)))))
+    return _kernel_defect(_commutator_map(n), beta) + off_family + lengths_kept
+
+
+@check("Prop 2.2", "negative control: the unnormalised binormal flow T_k × T_(k−1) (β_k = 1) does not "
+       "commute with the tangent flow", quantity="|M 1| / (|M|₂ |1|), M the commutator map of β",
+       at_least=1e-3, quick=dict(n=24))
+def unnormalised_binormal_flow_does_not_commute(ctx, n):
+    """The same commutator map applied to β = 1: not in its kernel."""
+    M = _commutator_map(n)
+    return float(np.linalg.norm(M @ np.ones(n)) / (np.linalg.norm(M, 2) * np.sqrt(n)))
+
+
+# --- (2.13): the tangents under the Heisenberg flow tend to the Heisenberg magnetic chain -------
+
+
+@jax.jit
+def _smooth_magnetic_chain(s):
+    """T'' × T of the smooth curve at the arc-length parameters s (2.13)."""
+    d = jax.jacfwd
+    return jnp.cross(jax.vmap(d(d(d(latitude_longitude_curve))))(s), jax.vmap(d(latitude_longitude_curve))(s))
+
+
+@check("Remark 2.3, eq (2.13)", "∂_t T_k = w_(k+1) − w_k with time scaled by ε²/2 tends to T'' × T at the edge "
+       "midpoints, order 2", quantity="fitted order",
+       quick=dict(ns=(32, 64, 128)), full=dict(ns=(32, 64, 128, 256, 512)), **ORDER_2)
+def heisenberg_chain_smooth_limit(ctx, ns):
+    """(2.14): ∂_t T_k = w_(k+1) − w_k, and w_k = (ε/2) T' × T + O(ε³) (Remark 2.3), so
+    (2/ε²) ∂_t T_k = T'' × T + O(ε²) at the edge midpoints: (2.13), the Heisenberg magnetic chain.
+    Observed orders 1.65, 1.87, 1.97, 1.99 from n = 16 to 256 (an O(ε⁴) term with a large constant)."""
+    def error(n):
+        gamma, eps, s = closed_curve(n)
+        midpoints = (s + np.append(s[1:], s[0] + 2 * np.pi)) / 2
+        dT = _tangents_moved_by(_heisenberg_flow, gamma)
+        return float(jnp.max(jnp.abs(2 / eps**2 * dT - _smooth_magnetic_chain(midpoints))))
+
+    table = dg.limits.convergence(error, ns, label="‖(2/ε²) ∂_t T_k − T″ × T‖∞")
+    return ctx.convergence(table, "convergence_heisenberg_chain").fitted_order
