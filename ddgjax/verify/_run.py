@@ -104,34 +104,62 @@ def _run_names(modules: list[str], names: list[str], out: str, quick: bool, queu
     return results
 
 
-def _run_parallel(checks: list[Check], out, quick: bool, jobs: int, advance) -> list[Outcome]:
-    """Run groups of checks in `jobs` spawned processes (JIT compilation is single-threaded, so
-    two cores compile two problems at once); returns outcomes in the order of `checks`."""
+def _warm_up() -> None:
+    """A worker's first task: import what every group of checks imports (JAX, the library)."""
+    importlib.import_module("ddgjax.verify.checks._shared")
+
+
+@contextmanager
+def _workers(jobs: int):
+    """`(pool, queue)`: `jobs` spawned worker processes, started at once (they import JAX and the
+    library while the caller loads the checks), and a queue for their progress; `None` if
+    `jobs` ≤ 1."""
+    if jobs <= 1:
+        yield None
+        return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    groups: dict[str, list[Check]] = {}
-    for c in checks:
-        groups.setdefault(_group(c), []).append(c)
-    tasks = sorted(groups.values(), key=len, reverse=True)
     # The checks solve small problems once each: XLA's compile time, not their run time, is
     # most of a run, and LLVM's backend optimisation off halves it.  Spawned workers start a
     # fresh JAX backend, so the setting applies there (unless XLA_FLAGS is set already).
     os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
     context = multiprocessing.get_context("spawn")
-    with context.Manager() as manager, ProcessPoolExecutor(jobs, mp_context=context) as pool:
-        queue = manager.Queue()
-        futures = [pool.submit(_run_names, sorted({c.fn.__module__ for c in task}), [c.name for c in task], str(out),
-                               quick, queue) for task in tasks]
-        while not all(f.done() for f in futures) or not queue.empty():
-            try:
-                advance(queue.get(timeout=0.5))
-            except Empty:
-                pass
-        results = {}
-        for task, future in zip(tasks, futures, strict=True):
-            for c, row in zip(task, _rows(task, future, quick), strict=True):
-                results[c.name] = row
+    with context.Manager() as manager:
+        pool = ProcessPoolExecutor(jobs, mp_context=context)
+        try:
+            for _ in range(jobs):
+                pool.submit(_warm_up)
+            yield pool, manager.Queue()
+        finally:
+            # idle now (or after an error): stop the workers instead of waiting for their JAX to
+            # shut down, seconds with thousands of compiled programs (no public API for this)
+            processes = list((getattr(pool, "_processes", None) or {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                process.terminate()
+
+
+def _run_parallel(checks: list[Check], out, quick: bool, workers, advance) -> list[Outcome]:
+    """Run groups of checks on the `(pool, queue)` of `_workers` (JIT compilation is
+    single-threaded, so two cores compile two problems at once), the longest groups first;
+    returns outcomes in the order of `checks`."""
+    pool, queue = workers
+    groups: dict[str, list[Check]] = {}
+    for c in checks:
+        groups.setdefault(_group(c), []).append(c)
+    tasks = sorted(groups.values(), key=len, reverse=True)
+    futures = [pool.submit(_run_names, sorted({c.fn.__module__ for c in task}), [c.name for c in task], str(out),
+                           quick, queue) for task in tasks]
+    while not all(f.done() for f in futures) or not queue.empty():
+        try:
+            advance(queue.get(timeout=0.5))
+        except Empty:
+            pass
+    results = {}
+    for task, future in zip(tasks, futures, strict=True):
+        for c, row in zip(task, _rows(task, future, quick), strict=True):
+            results[c.name] = row
     return [Outcome(c, **{k: v for k, v in results[c.name].items() if k != "name"}) for c in checks]
 
 
@@ -145,12 +173,15 @@ def _rows(task: list[Check], future, quick: bool) -> list[dict]:
 
 
 def run(checks: list[Check], out, *, quick: bool, progress: bool = False, debug: bool = False,
-        jobs: int = 1) -> list[Outcome]:
-    """Run `checks` (in `jobs` processes when > 1; `debug` runs in this process and re-raises);
-    figures go under `out/figures`."""
+        jobs: int = 1, workers=None) -> list[Outcome]:
+    """Run `checks` (in `jobs` processes when > 1, or on the started `workers` of `_workers`;
+    `debug` runs in this process and re-raises); figures go under `out/figures`."""
     with _progress(len(checks), progress) as advance:
-        if jobs > 1 and not debug and len(checks) > 1:
-            return _run_parallel(checks, out, quick, jobs, advance)
+        if workers is None and jobs > 1 and not debug and len(checks) > 1:
+            with _workers(jobs) as started:
+                return _run_parallel(checks, out, quick, started, advance)
+        if workers is not None and not debug and len(checks) > 1:
+            return _run_parallel(checks, out, quick, workers, advance)
         outcomes = []
         for c in checks:
             outcomes.append(run_check(c, Path(out), quick, debug))
@@ -173,10 +204,11 @@ def verify(out, *, quick: bool = False, only=None, progress: bool = False, debug
     held within tolerance.  A check module that fails to import counts as a failed check.
     """
     start = time.perf_counter()
-    errors = load_checks()
-    if debug and errors:
-        raise ImportError(f"check modules failed to import: {errors}")
-    outcomes = run(select(only), out, quick=quick, progress=progress, debug=debug, jobs=jobs)
+    with _workers(1 if debug else jobs) as workers:  # started before the checks load here
+        errors = load_checks()
+        if debug and errors:
+            raise ImportError(f"check modules failed to import: {errors}")
+        outcomes = run(select(only), out, quick=quick, progress=progress, debug=debug, jobs=jobs, workers=workers)
     if not only:
         outcomes += [_load_failure(m, msg) for m, msg in errors.items()]
     path = write_report(outcomes, out, quick=quick, seconds=time.perf_counter() - start)
