@@ -5,6 +5,7 @@ from __future__ import annotations
 import jax
 import numpy as np
 from scipy.optimize import brentq
+from scipy.sparse.linalg import spsolve
 
 import ddgjax as dg
 from ddgjax.errors import NonUniqueSolutionError
@@ -209,19 +210,21 @@ def _catenoid(n: int):
     return area.minimal_surface(*dg.mesh.builtin.cylinder(n), tol=0.05 / n**4, max_iter=4000)
 
 
-@check("Fig 6.5, Thm 6.7", "the Pinkall–Polthier iteration from the cylinder (stopped at max |L f| ≤ 1e-6) is critical "
-       "for the area and has less area than the cylinder",
-       quantity="max over interior vertices of |∇A| by autodiff of the declared area", at_most=1e-6,
-       quick=dict(n=16), full=dict(n=32))
+CATENOID_H2 = 0.25  # n² max_i |r_i − c cosh(z_i/c)| of the discrete minimum is 0.19–0.20 for n = 4…32
+
+
+@check("Fig 6.5, Thm 6.7", "the Pinkall–Polthier iteration from the cylinder (stopped at max |L f| ≤ 1e-6) lowers "
+       "the area and lands on the smooth catenoid r(z) = c cosh(z/c) (c cosh(H/c) = R) to O(h²), h = 1/n",
+       quantity="n² · max over vertices of |r_i − c cosh(z_i/c)| (the discrete minimum: 0.19–0.20 at n = 4…32)",
+       at_most=CATENOID_H2, quick=dict(n=16), full=dict(n=32))
 def catenoid_is_critical(ctx, n):
-    V, F, info = area.minimal_surface(*dg.mesh.builtin.cylinder(n), tol=1e-6, max_iter=4000)
+    V, F, info = area.minimal_surface(*dg.mesh.builtin.cylinder(n), method="cotan", tol=1e-6, max_iter=4000)
     plot_laplace.minimal_surface(V, F, ctx.figure("catenoid.png"), history=info["history"],
                                  title=f"Fig 6.5: catenoid, n = {n}")
     if not info["area"][-1] < info["area"][0]:
         return float("inf")
-    problem = area.simplicial(V, F)
-    gradient = np.asarray(jax.jit(jax.grad(problem.energy))(V, None))
-    return float(np.max(np.abs(gradient[_interior(len(V), dg.mesh.boundary_vertices(F, len(V)))])))
+    c = references.catenoid_neck()
+    return n**2 * float(np.max(np.abs(np.linalg.norm(V[:, :2], axis=1) - c * np.cosh(V[:, 2] / c))))
 
 
 @check("Fig 6.5", "the neck radius of the simplicial catenoid converges to the smooth catenoid's c (c cosh(H/c) = R), O(h²)",
@@ -283,12 +286,47 @@ def negative_weights_break_convex_hull(ctx):
     return float(V[0, 2] - V[1:, 2].max()) if ok else float("-inf")
 
 
-def _laplacian_error(n: int) -> float:
+JITTER = 0.2  # interior vertices move by ≤ 0.2 h in x and y: ≤ 0.57 h relative to an opposite side, < h/√2
+
+
+def _cot(p, q, r) -> np.ndarray:
+    """cot of the angle at p of the planar triangles (p, q, r), rows of (k, 2) arrays."""
+    u, v = q - p, r - p
+    return np.sum(u * v, 1) / np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+
+
+def _irregular_square(n: int, seed: int = 0):
+    """`(V, F, boundary)`: `unit_square(n)` with the interior vertices moved uniformly by up to
+    JITTER · h in x and y, each grid quad cut along its non-Delaunay diagonal (the two angles
+    opposite it sum to more than π: ν < 0 there, eq 6.3)."""
+    V, _, b = dg.mesh.builtin.unit_square(n)
+    inner = _interior(len(V), b)
+    V[inner, :2] += JITTER / n * np.random.default_rng(seed).uniform(-1, 1, size=(len(inner), 2))
+    Q = dg.mesh.builtin.grid_quads(n + 1, n + 1, False, False)  # (a, b, c, d) counterclockwise
+    a, p, c, d = (V[Q[:, k], :2] for k in range(4))
+    ac_not_delaunay = _cot(p, c, a) + _cot(d, a, c) < 0
+    return V, dg.mesh.builtin.triangulate(np.where(ac_not_delaunay[:, None], Q, np.roll(Q, -1, axis=1))), b
+
+
+LAPLACIANS = {"extrinsic": dg.laplace.cotan_laplacian, "intrinsic": dg.intrinsic.laplace_beltrami}
+
+
+def _laplacian_error(n: int, mesh=dg.mesh.builtin.unit_square, laplacian=dg.laplace.cotan_laplacian) -> float:
     """max over interior vertices of |−(L f)_i / M_i − Δf(x_i)|, f = sin(πx) cos(2y)."""
-    V, F, b = dg.mesh.builtin.unit_square(n)
+    V, F, b = mesh(n)
     f = np.sin(np.pi * V[:, 0]) * np.cos(2 * V[:, 1])
-    approx = -(dg.laplace.cotan_laplacian(V, F) @ f) / dg.laplace.barycentric_areas(V, F)
+    approx = -(laplacian(V, F) @ f) / dg.laplace.barycentric_areas(V, F)
     return float(np.max(np.abs(approx + (np.pi**2 + 4) * f)[_interior(len(V), b)]))
+
+
+def _irregular_harmonic_error(n: int, laplacian) -> float:
+    """√(Σ_i M_i (f_i − u_i)²) for the dDBVP solution f of `laplacian` on `_irregular_square(n)`
+    with the boundary values of the harmonic u = eˣ sin y (sparse LU of L_II)."""
+    V, F, b = _irregular_square(n)
+    u = np.exp(V[:, 0]) * np.sin(V[:, 1])
+    L, inner, f = laplacian(V, F).tocsr(), _interior(len(V), b), u.copy()
+    f[inner] = spsolve(L[inner][:, inner].tocsc(), -(L[inner][:, b] @ u[b]))
+    return float(np.sqrt(np.sum(dg.laplace.barycentric_areas(V, F) * (f - u) ** 2)))
 
 
 def _harmonic_error(n: int, figure=None) -> float:
@@ -317,3 +355,41 @@ def ddbvp_limit(ctx, ns):
     _harmonic_error(ns[0], figure=ctx.figure("ddbvp_harmonic.png"))
     table = dg.limits.convergence(_harmonic_error, ns, label="max error of f against u")
     return ctx.convergence(table, "convergence_ddbvp").fitted_order
+
+
+@check("Def 6.2, Def 7.8", "negative control: on jittered squares cut along their non-Delaunay diagonals −(L f)_i / M_i "
+       "does not tend to Δf(x_i), neither for the extrinsic cotan Laplacian nor for the intrinsic Delaunay one",
+       quantity="max over the two Laplacians of the fitted order of max |−Lf/M − Δf| (+∞ unless the error at the "
+       "finest n is ≥ 1)", at_most=0.5, quick=dict(ns=(8, 16, 32)), full=dict(ns=(8, 16, 32, 64, 128)))
+def cotan_laplacian_limit_irregular(ctx, ns):
+    orders = []
+    for name, laplacian in LAPLACIANS.items():
+        table = dg.limits.convergence(lambda n: _laplacian_error(n, _irregular_square, laplacian), ns,
+                                      label=f"max error of −Lf/M against Δf ({name})")
+        ctx.convergence(table, f"convergence_{name}_laplacian_irregular", title=f"{name} Laplacian, jittered square")
+        orders.append(table.fitted_order if table.errors[-1] >= 1.0 else float("inf"))
+    return max(orders)
+
+
+def _irregular_ddbvp_table(ctx, ns, name: str):
+    table = dg.limits.convergence(lambda n: _irregular_harmonic_error(n, LAPLACIANS[name]), ns,
+                                  label=f"mass-weighted L² error of f against u ({name})")
+    return ctx.convergence(table, f"convergence_ddbvp_{name}_irregular", title=f"dDBVP, {name} Laplacian, jittered square")
+
+
+@check("Def 6.2, Thm 6.6", "smooth limit (weak form): on jittered squares cut along their non-Delaunay diagonals "
+       "(negative weights) the dDBVP solution of the extrinsic cotan Laplacian still tends to the harmonic u, O(h²)",
+       quantity="fitted order of √(Σ M_i (f_i − u_i)²)", target=2.0, within=0.3, quick=dict(ns=(8, 16, 32)),
+       full=dict(ns=(8, 16, 32, 64, 128)))
+def ddbvp_limit_irregular(ctx, ns):
+    return _irregular_ddbvp_table(ctx, ns, "extrinsic").fitted_order
+
+
+@check("Def 7.8, Thm 6.6", "smooth limit (weak form): on the same meshes the dDBVP solution of the intrinsic Delaunay "
+       "Laplacian (Laplace–Beltrami) tends to u, O(h²), with a smaller error than the extrinsic one at every n",
+       quantity="fitted order of √(Σ M_i (f_i − u_i)²) (+∞ unless below the extrinsic error at every n)",
+       target=2.0, within=0.3, quick=dict(ns=(8, 16, 32)), full=dict(ns=(8, 16, 32, 64, 128)))
+def laplace_beltrami_ddbvp_limit_irregular(ctx, ns):
+    table = _irregular_ddbvp_table(ctx, ns, "intrinsic")
+    extrinsic = [_irregular_harmonic_error(n, LAPLACIANS["extrinsic"]) for n in ns]
+    return table.fitted_order if np.all(table.errors < extrinsic) else float("inf")
