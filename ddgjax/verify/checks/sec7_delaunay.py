@@ -13,8 +13,13 @@ import ddgjax as dg
 from ddgjax import intrinsic
 from ddgjax.intrinsic import rippa
 from ddgjax.intrinsic import triangulation as T
+from ddgjax.intrinsic.delaunay import DELAUNAY_TOL
+from ddgjax.intrinsic.flips import flip_batch, quad
+from ddgjax.intrinsic.geometry import flipped_length
 from ddgjax.mesh.lengths import corner_cotangents, face_harmonic_index, triangle_area
 from ddgjax.verify import check, figures
+
+from ._flip_surfaces import SURFACES, opposite_angle_sums, surfaces
 from energies.area import interior_residual
 
 
@@ -74,12 +79,6 @@ def flip_length_is_the_other_diagonal(ctx, n_inner, quadrilaterals):
     return worst if flipped > tri.n_edges // 2 else float("inf")
 
 
-def _opposite_angle_sums(tri) -> np.ndarray:
-    """(ne,) α + β: the angles opposite each edge, from `corner_angles` (side i of a face is
-    opposite its corner i + 2), independent of the cotangent test of the flip algorithm."""
-    return np.bincount(tri.edge, np.roll(T.corner_angles(tri), -2, axis=1).reshape(-1), minlength=tri.n_edges)
-
-
 @functools.cache
 def _flipped(level: int, bumps: float = 0.0):
     """The stretched icosphere, its triangulation and the result of the flip algorithm."""
@@ -88,44 +87,128 @@ def _flipped(level: int, bumps: float = 0.0):
     return tri, intrinsic.flip_to_delaunay(tri)
 
 
-@check("Prop 7.9, Thm 7.12", "the flip algorithm terminates on a skinny ellipsoid (symmetric, and with bumps) with "
-       "α + β ≤ π at every edge, and keeps the metric (the cone angles)",
-       quantity="max over edges of α + β − π after flipping, and of the change of the cone angles", at_most=1e-12,
-       quick=dict(level=2), full=dict(level=4))
-def flips_reach_angle_criterion(ctx, level):
+
+
+def _interior(halfedges) -> np.ndarray:
+    """The edges between two distinct triangles (the only ones the angle test can fail)."""
+    return np.flatnonzero((halfedges[:, 1] >= 0) & (halfedges[:, 0] // 3 != halfedges[:, 1] // 3))
+
+
+def _quarter_h(x, y, z, A):
+    return (x * x + y * y + z * z) / (4 * A)
+
+
+def _quad_flips(F, edge, halfedges, lengths, e) -> dict:
+    """Each interior edge e = ab of `e` flipped on its own (Lemma 5.8), from its five lengths by the law
+    of cosines, independent of the flip algorithm's keys: `g_old`, `g_new` the tie-normalised angle test
+    (cot α + cot β) / s of ab and of the new diagonal cd, s = (h(Δ₁) + h(Δ₂)) / 4 of the two triangles
+    (Lemma 7.17; the library's test is g < −1e-12); `area` |A(adc) + A(bcd) − A(abc) − A(bad)| / A (0 iff
+    the unfolded quadrilateral is convex: e can be flipped); `dh` the change of h(T); `cd` the new length."""
+    _, _, (ab, bc, ca, ad, db) = quad(F, edge, halfedges, lengths, e)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a non-convex quadrilateral: NaN areas
+        return _quad_flip_terms(ab, bc, ca, ad, db)
+
+
+def _quad_flip_terms(ab, bc, ca, ad, db) -> dict:
+    A1, A2 = triangle_area(ab, bc, ca), triangle_area(ab, ad, db)
+    cd = flipped_length(ab, bc, ca, ad, db, A1, A2)
+    B1, B2 = triangle_area(ad, cd, ca), triangle_area(bc, cd, db)
+    s_old, s_new = _quarter_h(ab, bc, ca, A1) + _quarter_h(ab, ad, db, A2), _quarter_h(ad, cd, ca, B1) + _quarter_h(bc, cd, db, B2)
+    cot_old = (bc * bc + ca * ca - ab * ab) / (4 * A1) + (ad * ad + db * db - ab * ab) / (4 * A2)
+    cot_new = (ad * ad + ca * ca - cd * cd) / (4 * B1) + (bc * bc + db * db - cd * cd) / (4 * B2)
+    return dict(g_old=cot_old / s_old, g_new=cot_new / s_new, area=np.abs(B1 + B2 - A1 - A2) / (A1 + A2),
+                dh=4 * (s_new - s_old), cd=cd)
+
+
+def _of(tri) -> dict:
+    """`_quad_flips` of every interior edge of `tri`."""
+    return _quad_flips(tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths, _interior(tri.halfedges))
+
+
+def _rounds(tri, seed: int) -> dict:
+    """Fig 7.13 with other choices than the library's sweep: in rounds, a random maximal set of
+    non-Delaunay edges no two on one face (each stays non-Delaunay until its turn: its two faces are
+    untouched) is flipped one after the other (`flips.flip_batch`).  Records at every state every
+    non-Delaunay edge flipped on its own (`g_new`, `area`: Lemma 7.11), and per flip Δh (Cor 7.19),
+    h(T) and an upper bound of the longest edge l(T) (the running maximum; Lemma 7.20)."""
+    F, edge, halfedges, lengths = (np.array(a) for a in (tri.F.reshape(-1), tri.edge, tri.halfedges, tri.lengths))
+    rng = np.random.default_rng(seed)
+    steps, longest, g_new, area = [], [[tri.lengths.max()]], [], []
+    for _ in range(10 * tri.n_faces):
+        e = _interior(halfedges)
+        q = _quad_flips(F, edge, halfedges, lengths, e)
+        bad = q["g_old"] < -DELAUNAY_TOL
+        g_new.append(q["g_new"][bad])
+        area.append(q["area"][bad])
+        if not bad.any():
+            break
+        used, batch = set(), []
+        for k in rng.permutation(np.flatnonzero(bad)):
+            faces = set((halfedges[e[k]] // 3).tolist())
+            if not faces & used:
+                used |= faces
+                batch.append(k)
+        longest.append(np.maximum(lengths.max(), np.maximum.accumulate(q["cd"][batch])))
+        steps.append(q["dh"][batch])
+        flip_batch(F, edge, halfedges, lengths, e[batch])
+    steps = np.concatenate(steps)
+    return dict(end=T.of_arrays(F, edge, halfedges, lengths, tri.n_vertices), steps=steps,
+                h=intrinsic.harmonic_index(tri) + np.concatenate([[0.0], np.cumsum(steps)]),
+                longest=np.concatenate(longest), g_new=np.concatenate(g_new), area=np.concatenate(area))
+
+
+@functools.cache
+def _runs(level: int, n_inner: int, torus: tuple[int, int]) -> dict:
+    """name → (start, the library's `flip_to_delaunay`, `_rounds`) on the surfaces of
+    `_flip_surfaces.surfaces` (stretched icosphere with and without bumps, skinny noisy torus,
+    skinny flat disk)."""
+    return {name: (start, intrinsic.flip_to_delaunay(start), _rounds(start, seed=1))
+            for name, (start, _) in surfaces(level, n_inner, torus).items()}
+
+
+def _total_area(tri) -> float:
+    return float(np.sum(triangle_area(*T.side_lengths(tri).T)))
+
+
+@check("Prop 7.9, Thm 7.12", "the flip algorithm terminates on a stretched icosphere (symmetric, and with bumps), a "
+       "skinny noisy torus and a skinny flat disk with α + β ≤ π at every interior edge, and keeps the metric (the cone "
+       "angles); so does Fig 7.13 with random choices (rounds of flips of disjoint non-Delaunay edges)",
+       quantity="max over the 8 runs and their interior edges of α + β − π after flipping, and of the change of the cone "
+       "angles (∞ unless every run flips > 10 edges and every edge passes the angle test, cot α + cot β ≥ −1e-12 s)",
+       at_most=1e-12, **SURFACES)
+def flips_reach_angle_criterion(ctx, level, n_inner, torus):
     worst = 0.0
-    for bumps in (0.0, 0.1):
-        tri, result = _flipped(level, bumps)
-        if result.n_flips <= 10 or not intrinsic.is_delaunay(result):
-            return float("inf")
-        worst = max(worst, float(np.max(_opposite_angle_sums(result.triangulation)) - np.pi),
-                    float(np.max(np.abs(T.cone_angles(result.triangulation) - T.cone_angles(tri)))))
+    for start, result, rounds in _runs(level, n_inner, torus).values():
+        for end, n_flips in ((result.triangulation, result.n_flips), (rounds["end"], len(rounds["steps"]))):
+            if n_flips <= 10 or not intrinsic.is_delaunay(end) or np.any(_of(end)["g_old"] < -DELAUNAY_TOL):
+                return float("inf")
+            worst = max(worst, float(np.max(opposite_angle_sums(end)[_interior(end.halfedges)])) - np.pi,
+                        float(np.max(np.abs(T.cone_angles(end) - T.cone_angles(start)))))
     return worst
 
 
-@check("Prop 7.9", "negative control: before flipping, the skinny ellipsoid has edges with α + β > π",
-       quantity="max over edges of α + β − π before flipping", at_least=0.1, quick=dict(level=2), full=dict(level=4))
-def skinny_start_violates_angle_criterion(ctx, level):
-    tri, _ = _flipped(level)
-    return float(np.max(_opposite_angle_sums(tri)) - np.pi)
+@check("Prop 7.9", "negative control: before flipping, each of the four surfaces has edges with α + β > π",
+       quantity="min over the starts of max over edges of α + β − π", at_least=0.1, **SURFACES)
+def skinny_start_violates_angle_criterion(ctx, level, n_inner, torus):
+    return min(float(np.max(opposite_angle_sums(start)) - np.pi) for start, _, _ in _runs(level, n_inner, torus).values())
 
 
-@check("Prop 7.10", "the cotan weights of the Delaunay triangulation are ≥ 0",
-       quantity="max(0, −min ν) / max ν after flipping (skinny ellipsoid, symmetric and with bumps)", at_most=1e-12,
-       quick=dict(level=2), full=dict(level=4))
-def delaunay_weights_nonnegative(ctx, level):
+@check("Prop 7.10", "the cotan weights of the Delaunay triangulation are ≥ 0 at every interior edge",
+       quantity="max over the four surfaces of max(0, −min ν) / max ν over the interior edges after flipping",
+       at_most=1e-12, **SURFACES)
+def delaunay_weights_nonnegative(ctx, level, n_inner, torus):
     worst = 0.0
-    for bumps in (0.0, 0.1):
-        nu = _flipped(level, bumps)[1].cotan_weights()
-        worst = max(worst, -float(nu.min()) / float(nu.max()))
+    for _, result, _ in _runs(level, n_inner, torus).values():
+        nu = result.cotan_weights()
+        worst = max(worst, -float(nu[_interior(result.triangulation.halfedges)].min()) / float(nu.max()))
     return worst
 
 
-@check("Prop 7.10, eq (6.3)", "negative control: the start triangulation (not Delaunay) has negative cotan weights",
-       quantity="−min ν / max ν before flipping", at_least=1e-2, quick=dict(level=2), full=dict(level=4))
-def start_weights_negative(ctx, level):
-    nu = intrinsic.cotan_weights(_flipped(level)[0])
-    return -float(nu.min()) / float(nu.max())
+@check("Prop 7.10, eq (6.3)", "negative control: the start triangulations (not Delaunay) have negative cotan weights",
+       quantity="min over the four starts of −min ν / max ν (the torus: 6e-3)", at_least=1e-3, **SURFACES)
+def start_weights_negative(ctx, level, n_inner, torus):
+    weights = (intrinsic.cotan_weights(start) for start, _, _ in _runs(level, n_inner, torus).values())
+    return min(-float(nu.min()) / float(nu.max()) for nu in weights)
 
 
 def _lemma_7_17_error(count: int) -> float:
@@ -138,22 +221,68 @@ def _lemma_7_17_error(count: int) -> float:
     return float(np.max(np.abs(np.asarray(h) - np.asarray(cots)) / np.asarray(h)))
 
 
-@check("Cor 7.19, Lemma 7.17, 7.18", "the harmonic index h(T) strictly decreases at every flip; h(Δ) = 4 Σ cot on every "
-       "triangle and h(T) = 8 Σ E(φ_i) = 4 tr L before and after flipping",
-       quantity="max over flips of Δh / h(T_0) (∞ unless h(Δ) = 4 Σ cot on random triangles and h(T) = 4 tr L at both ends "
-       "agree to 1e-12 relative, and the recorded h(T_0) to 1e-14)", at_most=-1e-12, quick=dict(level=2, triangles=100),
-       full=dict(level=4, triangles=10_000))
-def harmonic_index_decreases(ctx, level, triangles):
-    tri, result = _flipped(level)
-    h = result.harmonic_index
+@check("Cor 7.19, Lemma 7.17, 7.18", "the harmonic index h(T) strictly decreases at every flip of every run (the "
+       "library's and Fig 7.13 with random choices, on the four surfaces); h(Δ) = 4 Σ cot on every triangle and h(T) = "
+       "8 Σ E(φ_i) = 4 tr L before and after flipping",
+       quantity="max over all flips of all 8 runs of Δh / h(T_0) (∞ unless h(Δ) = 4 Σ cot on random triangles and h(T) "
+       "= 4 tr L at both ends agree to 1e-12 relative, the recorded h(T_0) to 1e-14, and both runs end at one h)",
+       at_most=-1e-12, quick=dict(SURFACES["quick"], triangles=100), full=dict(SURFACES["full"], triangles=10_000))
+def harmonic_index_decreases(ctx, level, n_inner, torus, triangles):
     trace = lambda t: 4.0 * float(intrinsic.cotan_laplacian(t).diagonal().sum())  # noqa: E731
-    h_start = intrinsic.harmonic_index(tri)
-    identities = max(_lemma_7_17_error(triangles), abs(h_start - trace(tri)) / h[0],
-                     abs(h[-1] - trace(result.triangulation)) / h[-1])
-    recorded = abs(h[0] - h_start) / h[0]
-    if not result.n_flips or identities > 1e-12 or recorded > 1e-14 or np.any(result.harmonic_index_steps >= 0):
+    identities, worst = _lemma_7_17_error(triangles), -np.inf
+    for start, result, rounds in _runs(level, n_inner, torus).values():
+        h, h_start = result.harmonic_index, intrinsic.harmonic_index(start)
+        if not result.n_flips or abs(h[0] - h_start) / h[0] > 1e-14:
+            return float("inf")
+        identities = max(identities, abs(h_start - trace(start)) / h[0], abs(h[-1] - trace(result.triangulation)) / h[-1],
+                         abs(rounds["h"][-1] - h[-1]) / h[-1])
+        worst = max(worst, float(np.max(result.harmonic_index_steps)) / h[0], float(np.max(rounds["steps"])) / h[0])
+    return float("inf") if identities > 1e-12 else worst
+
+
+@check("Lemma 7.11", "every non-Delaunay edge can be flipped and the flipped edge is then Delaunay: every non-Delaunay "
+       "edge of every state of Fig 7.13 with random choices on the four surfaces, flipped on its own",
+       quantity="max over those edges of −(cot α + cot β) / s of the new diagonal (s = (h(Δ₁) + h(Δ₂)) / 4) and of the "
+       "convexity defect |ΔA| / A of the unfolded quadrilateral (∞ unless ≥ 1000 edges are tested)", at_most=1e-12,
+       **SURFACES)
+def flipped_edge_is_delaunay(ctx, level, n_inner, torus):
+    runs = [rounds for _, _, rounds in _runs(level, n_inner, torus).values()]
+    if sum(r["g_new"].size for r in runs) < 1000:
         return float("inf")
-    return float(np.max(np.diff(h))) / h[0]
+    return max(max(float(np.max(-r["g_new"])), float(np.max(r["area"]))) for r in runs)
+
+
+@check("Lemma 7.11, Lemma 5.8", "negative control: Delaunay edges of the starts are not flippable (their unfolded "
+       "quadrilateral is not convex) or become non-Delaunay when flipped",
+       quantity="min over the four starts of the number of Delaunay interior edges with convexity defect > 1e-9 (or "
+       "NaN: no triangle) or a flipped diagonal failing the angle test", at_least=50, **SURFACES)
+def delaunay_edges_fail_lemma_7_11(ctx, level, n_inner, torus):
+    counts = []
+    for start, _, _ in _runs(level, n_inner, torus).values():
+        q = _of(start)
+        good = q["g_old"] >= -DELAUNAY_TOL
+        counts.append(int(np.sum(good & ~((q["area"] <= 1e-9) & (q["g_new"] >= -DELAUNAY_TOL)))))
+    return float(min(counts))
+
+
+@check("Lemma 7.20, Example 7.3", "the harmonic index bounds the longest edge: h(T) ≥ l(T)² / A at every flip of every "
+       "run (the four surfaces and the cube made with edges longer than 3; the reference prints l(T)/A, but its proof "
+       "uses l(T) ≤ √(h(T) A))", quantity="max over the runs and their states of l(T)² / (A h(T)) (l(T) bounded by "
+       "the running maximum of the lengths; ∞ unless every run keeps the total area A to 1e-12)", at_most=1.0,
+       quick=dict(SURFACES["quick"], steps=25), full=dict(SURFACES["full"], steps=40))
+def harmonic_index_bounds_longest_edge(ctx, level, n_inner, torus, steps):
+    V, F = dg.mesh.cube(triangulated=True)
+    cube = _lengthen(T.from_mesh(V, F), steps, seed=3)
+    if cube.lengths.max() <= 3.0:
+        return float("inf")
+    runs = [(start, rounds) for start, _, rounds in _runs(level, n_inner, torus).values()]
+    worst = 0.0
+    for start, rounds in runs + [(cube, _rounds(cube, seed=1))]:
+        A = _total_area(start)
+        if abs(_total_area(rounds["end"]) - A) > 1e-12 * A:
+            return float("inf")
+        worst = max(worst, float(np.max(rounds["longest"] ** 2 / (A * rounds["h"]))))
+    return worst
 
 
 @check("Fig 7.13, Prop 7.9", "figure: a flat disk with skinny triangles before and after flipping to Delaunay",

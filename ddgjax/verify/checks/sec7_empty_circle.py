@@ -16,7 +16,6 @@ positive iff d lies inside the circumcircle of (a, b, c); likewise m_c for c and
 
 from __future__ import annotations
 
-import functools
 
 import numpy as np
 from scipy.spatial import ConvexHull, Delaunay
@@ -29,7 +28,7 @@ from ddgjax.intrinsic.geometry import apex
 from ddgjax.mesh.lengths import normalised, triangle_area
 from ddgjax.verify import check
 
-from .sec7_delaunay import _opposite_angle_sums
+from ._flip_surfaces import SURFACES, opposite_angle_sums, surfaces
 
 TIE = 1e-9  # |margin| below this: on the circle (the library's tie band is 1e-12 in cot α + cot β)
 
@@ -80,31 +79,9 @@ def _disagreements(tri) -> tuple[int, int]:
     e, m_d, m_c = unfolded_margins(tri)
     side = _side(m_d)
     fails = ~intrinsic.delaunay_edges(tri)[e]
-    off_pi = np.abs(_opposite_angle_sums(tri)[e] - np.pi) > 1e-8
+    off_pi = np.abs(opposite_angle_sums(tri)[e] - np.pi) > 1e-8
     wrong = ((side == 1) & ~fails) | ((side == -1) & fails) | ((side == 0) & off_pi) | (side != _side(m_c))
     return int(wrong.sum()), int(np.sum(side == 1))
-
-
-@functools.cache
-def _surfaces(level: int, n_inner: int, torus: tuple[int, int]):
-    """name → (start, Delaunay by flips): the stretched icosphere (symmetric: exact ties; and with
-    bumps), a skinny torus (m × n long thin quads, radii scaled by 1 + 0.05 N(0, 1)) and a flat disk
-    with skinny random triangles (`tall_dome` at height 0)."""
-    m, n = torus
-    Vt, Ft = dg.mesh.torus(m, n, 1.0, 0.4)
-    Vt = Vt * (1 + 0.05 * np.random.default_rng(0).standard_normal((len(Vt), 1)))
-    meshes = {"stretched icosphere": dg.mesh.builtin.stretched_sphere(level),
-              "bumpy stretched icosphere": dg.mesh.builtin.stretched_sphere(level, bumps=0.1),
-              "skinny torus": (Vt, Ft), "flat disk": dg.mesh.builtin.tall_dome(0, n_inner=n_inner, height=0.0)[:2]}
-    out = {}
-    for name, (V, F) in meshes.items():
-        tri = T.from_mesh(V, F)
-        out[name] = tri, intrinsic.flip_to_delaunay(tri).triangulation
-    return out
-
-
-# quick sizes: 320 triangles each, the shape the compiled kernels of `sec7_delaunay` already ran on
-SURFACES = dict(quick=dict(level=2, n_inner=145, torus=(5, 32)), full=dict(level=4, n_inner=400, torus=(12, 64)))
 
 
 @check("Def 7.4, Lemma 7.3, Lemma 7.8, Thm 7.7", "on unfolded edges, the empty-circumdisk test agrees edge by edge with "
@@ -115,7 +92,7 @@ SURFACES = dict(quick=dict(level=2, n_inner=145, torus=(5, 32)), full=dict(level
        "start has an edge failing both tests)", at_most=0, **SURFACES)
 def empty_circumdisk_matches_angle_criterion(ctx, level, n_inner, torus):
     total = 0
-    for start, flipped in _surfaces(level, n_inner, torus).values():
+    for start, flipped in surfaces(level, n_inner, torus).values():
         (wrong_start, inside_start), (wrong_flipped, _) = _disagreements(start), _disagreements(flipped)
         if inside_start == 0:
             return float("inf")
@@ -127,7 +104,7 @@ def empty_circumdisk_matches_angle_criterion(ctx, level, n_inner, torus):
        "strictly inside the other triangle's circumcircle", quantity="min over the four start surfaces of the number of "
        "such edges", at_least=5, **SURFACES)
 def start_circumdisks_not_empty(ctx, level, n_inner, torus):
-    return float(min(_disagreements(start)[1] for start, _ in _surfaces(level, n_inner, torus).values()))
+    return float(min(_disagreements(start)[1] for start, _ in surfaces(level, n_inner, torus).values()))
 
 
 def _triples(F) -> set:
@@ -366,5 +343,5 @@ def cocircular_cells_are_unique(ctx, k, outer):
             return float("inf")
         mismatch = len(cells ^ other) + len({c for c in cells if len(c) > 3} ^ expected)
         disk = _surface_disk_defect(tris[0], deleted) if P is None else _planar_disk_defect(P, cells)
-        total += mismatch + disk + float(np.max(np.abs(_opposite_angle_sums(tris[0])[deleted] - np.pi)))
+        total += mismatch + disk + float(np.max(np.abs(opposite_angle_sums(tris[0])[deleted] - np.pi)))
     return total
