@@ -102,8 +102,8 @@ def _steiner_cube_errors(ctx, levels, scale_H=1.0):
 
 @check("Thm 5.7", "Steiner's formula A(S_ρ) = A + 2H(S)ρ + 4πρ² on the cube: H(S) of Def 5.3 against the area of "
        "∂P_ρ sampled from the distance function (inscribed triangulations, Richardson-extrapolated)",
-       quantity="max relative error over ρ ∈ {0.1, 0.5, 2}", at_most=2e-4, quick=dict(levels=(4, 5)),
-       full=dict(levels=(4, 5, 6)))
+       quantity="max relative error over ρ ∈ {0.1, 0.5, 2}", at_most=2e-4, quick=dict(levels=(3, 4, 5)),
+       full=dict(levels=(3, 4, 5, 6)))
 def steiner_cube(ctx, levels):
     return max(_steiner_cube_errors(ctx, levels))
 
