@@ -71,7 +71,8 @@ class Trial(NamedTuple):
 
 
 def _lm_direction(linear, K, R, theta, wanted):
-    """The Levenberg–Marquardt step `d = −(KᵀK + ν I)⁻¹ KᵀR`, `ν = θ|R|`, if `wanted`, else 0.
+    """The Levenberg–Marquardt step `d = −(KᵀK + ν I)⁻¹ KᵀR`, `ν = θ|R|`, and `K d` (for the
+    predicted decrease), if `wanted`, else zeros: the Newton trials pay neither.
 
     A loop that runs 0 or 1 times rather than `lax.cond`: under `vmap` a cond with a batched
     predicate batches all its operands, incl. the sparse index arrays, which KLU cannot take
@@ -79,9 +80,11 @@ def _lm_direction(linear, K, R, theta, wanted):
     nu = theta * jnp.linalg.norm(R)
 
     def body(carry):
-        return linear.lm_solve_matrix(K, nu, R), jnp.asarray(False)
+        d = linear.lm_solve_matrix(K, nu, R)
+        return d, linear.matvec(K, d), jnp.asarray(False)
 
-    return jax.lax.while_loop(lambda carry: carry[1], body, (jnp.zeros_like(R), wanted))[0]
+    d, Kd, _ = jax.lax.while_loop(lambda carry: carry[2], body, (jnp.zeros_like(R), jnp.zeros_like(R), wanted))
+    return d, Kd
 
 
 def _step(kkt: KKT, linear, K, w, R, theta):
@@ -116,12 +119,13 @@ def _step(kkt: KKT, linear, K, w, R, theta):
     def body(t: Trial) -> Trial:
         alpha = 0.5 * t.alpha  # the first trial is α = 1; after 2⁻¹⁰, the LM trial
         lm = alpha < MIN_NEWTON_STEP
-        d = jnp.where(lm, _lm_direction(linear, K, R, t.theta, lm), alpha * delta)
+        d_lm, Kd_lm = _lm_direction(linear, K, R, t.theta, lm)
+        d = jnp.where(lm, d_lm, alpha * delta)
         R_new = kkt.residual(w + d)
         simplified = jnp.linalg.norm(linear.apply(fac, -R_new))
         newton_ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & jnp.isfinite(size)
         newton_ok = newton_ok & (simplified <= (1 - alpha / 4) * size)
-        predicted = _merit(R) - _merit(R + linear.matvec(K, d))
+        predicted = _merit(R) - _merit(R + Kd_lm)  # meaningful in the LM trial only
         rho = jnp.where(predicted > 0, (_merit(R) - _merit(R_new)) / predicted, -1.0)
         rho = jnp.where(jnp.isfinite(rho) & jnp.all(jnp.isfinite(d)), rho, -1.0)
         theta_lm = jnp.where(rho < 0.25, 4.0 * t.theta, jnp.where(rho > 0.75, jnp.maximum(t.theta / 4, THETA_MIN), t.theta))
