@@ -26,9 +26,12 @@ harmonic for its own cotan Laplacian, L f = 0 at the interior vertices.
 In practice Fig 6.5 brings the area gradient down fast to ~1e-5 (for O(1) surfaces) and then
 creeps: the remaining motion is mostly tangential and contracts by ~1 % per step on the catenoid
 of `tests/test_area.py`.  Newton started from such an iterate converges in two or three steps;
-started from a coarse guess (the cylinder) it does not (area is not convex).  So: `"cotan"` to a
-loose `tol`, then `"newton"` from its result.  From a start with skinny triangles Fig 6.5 may
-degenerate where Fig 7.23 converges (Fig 7.26).
+started from a coarse guess (the cylinder) it does not (area is not convex).  From a start with
+skinny triangles Fig 6.5 may degenerate where Fig 7.23 converges (Fig 7.26), and the area on a
+fixed triangulation can decrease by degenerating triangles tangentially (on polar disks of
+Enneper's surface Newton's minimisation collapses the central fan's slivers).  So `"auto"`:
+Fig 7.23 to a loose `tol`, then a minimisation on that triangulation, re-made Delaunay when a
+triangle degenerates.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ from jaxtyping import Array, Float
 
 import ddgjax as dg
 from ddgjax import intrinsic
-from ddgjax.errors import ConvergenceError, DDGError, InvalidInputError
+from ddgjax.errors import ConvergenceError, DDGError, DegenerateFaceError, InvalidInputError
 from ddgjax.laplace import (
     check_nondegenerate,
     checked_triangle_mesh,
@@ -56,6 +59,8 @@ __all__ = ["METHODS", "face_area", "harmonic_iteration", "interior_residual", "m
 METHODS = ("auto", "cotan", "newton", "delaunay")
 LOOSE_TOL = 1e-4  # the "auto" method's switch from Fig 6.5 to Newton, relative to the boundary's size
 LOOSE_ITER = 200
+NEWTON_ROUND = 20  # "auto": Newton steps between two Delaunay retriangulations
+FLIP_ROUNDS = 4  # "auto": retriangulations when Newton's minimisation degenerates
 
 
 def face_area(P: Float[Array, "3 3"], params=None) -> Float[Array, ""]:
@@ -220,7 +225,8 @@ PINCH = 1e-8  # a face whose area falls below this fraction of the mean has coll
 
 def _pinched(V, F) -> int | None:
     """The first face of (V, F) whose area collapsed (below `PINCH` × the mean), or None."""
-    areas = np.asarray(face_areas(V, F)) if np.all(np.isfinite(V)) else np.zeros(len(F))
+    with np.errstate(invalid="ignore"):  # Heron's formula is NaN (collapsed) past a triangle inequality
+        areas = np.asarray(face_areas(V, F)) if np.all(np.isfinite(V)) else np.zeros(len(F))
     small = np.flatnonzero(~(areas > PINCH * max(float(np.mean(areas)), 1e-300)))
     return int(small[0]) if small.size else None
 
@@ -234,25 +240,52 @@ def _pinch_error(V, F, where: str, cause=None) -> ConvergenceError:
         "apart for a catenoid); the input mesh is not at fault", residual=float("nan"), steps=0)
 
 
+def _degenerate_error(V, F, flips: int, cause: str) -> ConvergenceError:
+    face = _pinched(V, F)
+    what = f"face {face} degenerated" if face is not None else cause
+    return ConvergenceError(
+        f"minimal_surface: Newton's minimisation of the area found no minimum ({what}, after {flips} "
+        "Delaunay flips of the triangulation): the simplicial area has no nondegenerate local minimum on "
+        "this triangulation near the start (its tangential directions are nearly flat and degenerate "
+        "triangles lower it); method='delaunay' gives a minimal surface in the narrow sense (Def 7.9), "
+        "method='newton' a critical point of any index", residual=float("nan"), steps=0)
+
+
 def _auto(V, F, boundary, tol, max_iter):
-    """Fig 6.5 to a loose tolerance, then a minimisation by Newton with inertia correction
-    (`solvers.minimize`): a local minimum of the area, to `tol`."""
+    """Fig 7.23 to a loose tolerance (the Pinkall–Polthier iteration on a triangulation kept
+    intrinsically Delaunay by flips), then minimisation of the area on that triangulation by
+    Newton with inertia correction (`solvers.minimize`), `NEWTON_ROUND` steps at a time; when a
+    round ends unconverged (a triangle degenerating), the triangulation is made Delaunay again
+    for the current surface and the minimisation goes on, at most `FLIP_ROUNDS` times.  The result
+    is a local minimum of the area on the returned triangulation, to `tol`."""
     from solvers import minimize
 
     V0, F, b = _checked(V, F, boundary)
     loose = max(tol, LOOSE_TOL * float(np.ptp(V0[b], axis=0).max() if b.size else 1.0))
-    V1, F, pp = harmonic_iteration(V0, F, b, flip=False, tol=loose, max_iter=min(LOOSE_ITER, max_iter))
+    V1, F, pp = harmonic_iteration(V0, F, b, flip=True, tol=loose, max_iter=min(LOOSE_ITER, max_iter))
     if pp["breakdown"] is not None or _pinched(V1, F) is not None:
         raise _pinch_error(V1, F, f"the Pinkall–Polthier iteration (step {pp['iterations']})", pp["breakdown"])
-    sol = minimize(simplicial(V1, F, b), tol=tol, max_steps=max(max_iter - pp["iterations"], 0), throw=False)
-    V2 = np.asarray(sol.x)
-    if _pinched(V2, F) is not None:
-        raise _pinch_error(V2, F, "Newton's minimisation")
-    history = np.concatenate([pp["history"][:-1], np.asarray(sol.history)])
+    history, flips, budget = [pp["history"][:-1]], int(pp["flips"].sum()), max(max_iter - pp["iterations"], 0)
+    for round_ in range(FLIP_ROUNDS + 1):
+        steps = budget if round_ == FLIP_ROUNDS else min(NEWTON_ROUND, budget)
+        try:
+            sol = minimize(simplicial(V1, F, b), tol=tol, max_steps=steps, throw=False)
+        except DegenerateFaceError as error:
+            raise _degenerate_error(V1, F, flips, "a triangle degenerated") from error
+        V1, budget = np.asarray(sol.x), budget - int(sol.steps)
+        history.append(np.asarray(sol.history) if round_ == 0 else np.asarray(sol.history)[1:])
+        if sol.converged or budget == 0 or round_ == FLIP_ROUNDS or _pinched(V1, F) is not None:
+            break
+        V1, F, retriangulated = harmonic_iteration(V1, F, b, flip=True, max_iter=0)
+        flips += int(retriangulated["flips"].sum())
+    if not sol.converged and (_pinched(V1, F) is not None or not np.isfinite(float(sol.residual))):
+        raise _degenerate_error(V1, F, flips, f"gradient {float(sol.residual):.1e}")
+    history = np.concatenate(history)
     info = {"method": "auto", "iterations": len(history) - 1, "history": history, "residual": float(history[-1]),
             "area": np.concatenate([pp["area"], [float(sol.energy)]]), "converged": bool(sol.converged),
-            "cotan_iterations": pp["iterations"], "newton_iterations": int(sol.steps), "minimum": bool(sol.converged)}
-    return V2, F, info
+            "cotan_iterations": pp["iterations"], "newton_iterations": len(history) - 1 - pp["iterations"],
+            "flips": flips, "minimum": bool(sol.converged)}
+    return V1, F, info
 
 
 def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1e-10,
@@ -260,9 +293,11 @@ def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1
     """A simplicial minimal surface spanned by the fixed `boundary` vertices of (V, F), started
     from V: `(V_min, F, info)`.
 
-    **Arguments:** `method` `"auto"` (default: Fig 6.5 to a loose tolerance, 1e-4 of the
-    boundary's size, then Newton's method with inertia correction, `solvers.minimize`: a local
-    *minimum* of the area, never a saddle, converged to `tol`), `"cotan"` (Fig 6.5,
+    **Arguments:** `method` `"auto"` (default: Fig 7.23 to a loose tolerance, 1e-4 of the
+    boundary's size, then Newton's method with inertia correction, `solvers.minimize`, on that
+    triangulation, made intrinsically Delaunay again when a triangle degenerates on the way: a
+    local *minimum* of the area on the returned triangulation, never a saddle, converged to
+    `tol`), `"cotan"` (Fig 6.5,
     Pinkall–Polthier alone: fast to ~1e-5, then creeping), `"delaunay"` (Fig 7.23, a minimal
     surface in the narrow sense; `delaunay_tol=` the flips' tie tolerance) or `"newton"`
     (`solvers.solve` on `simplicial`, a critical point of any index; `solve_method=` is solve's
@@ -270,14 +305,18 @@ def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1
     at the interior vertices is `<= tol`; `max_iter`: iterations (both phases of `"auto"`
     together); `throw`: raise `ConvergenceError` if not converged.
 
-    **Returns:** `V_min` (nv, 3), `F` (for `"delaunay"` the final triangulation), and `info` as
-    `harmonic_iteration` (Newton and auto: `method`, `iterations`, `history`, `area`, `residual`,
-    `converged`; auto also `cotan_iterations`, `newton_iterations` and `minimum`: no negative
-    eigenvalue of the area Hessian on the free vertices).
+    **Returns:** `V_min` (nv, 3), `F` (for `"delaunay"` and `"auto"` the final triangulation:
+    the input's where no edge was flipped), and `info` as `harmonic_iteration` (Newton and auto:
+    `method`, `iterations`, `history`, `area`, `residual`, `converged`; auto also
+    `cotan_iterations`, `newton_iterations`, `flips` and `minimum`: no negative eigenvalue of the
+    area Hessian on the free vertices).
 
     **Raises:** `InvalidInputError` (unknown method or option), the errors of `simplicial`,
     `ConvergenceError` (not converged, an iterate degenerated, or, for `"auto"`, the surface
-    pinched: no minimal surface near the start).
+    pinched during the first phase: no minimal surface near the start; or a triangle
+    degenerated during the minimisation: no nondegenerate minimum of the area on this
+    triangulation near the start, which happens on fine meshes whose tangential directions are
+    nearly flat, e.g. polar disks of 12 or more rings).
     """
     if method not in METHODS:
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")

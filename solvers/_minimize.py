@@ -81,7 +81,8 @@ def _convexified(linear, K, delta: float):
 
 
 def _positive_definite(linear, K, delta_last: float):
-    """`(solve, δ)` with `H + δI` positive definite, δ chosen as in the module docstring."""
+    """`(solve, δ)` with `H + δI` positive definite, δ chosen as in the module docstring; `(None, δ)`
+    when no δ ≤ 10²⁰ max|H| does (non-finite entries)."""
     scale = _scale(linear, K)
     delta = 0.0
     while True:
@@ -89,8 +90,7 @@ def _positive_definite(linear, K, delta_last: float):
         if negative == 0:
             return solve_with, delta
         if delta > DELTA_MAX * scale:
-            raise ConvergenceError("minimize: no shift makes the Hessian positive definite (non-finite entries?)",
-                                   residual=float("nan"), steps=0)
+            return None, delta
         delta = max(DELTA_MIN * scale, delta_last / DELTA_DECAY) if delta == 0.0 else DELTA_GROWTH * delta
 
 
@@ -109,7 +109,8 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
     parameters like `solve`'s).
 
     **Raises:** `InvalidInputError` (constraints, or a linear solver without inertia),
-    `ConvergenceError` (not converged within `max_steps`, or the line search failed).
+    `ConvergenceError` (with `throw`: not converged within `max_steps`, the line search
+    failed, or the Hessian has non-finite entries).
     """
     spec = spec_of(problem)
     if spec.m:
@@ -142,6 +143,9 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
         if step == max_steps:
             break
         solve_with, delta = _positive_definite(linear, K, delta)
+        if solve_with is None:
+            status = "no shift makes the Hessian positive definite (non-finite entries: a degenerate configuration)"
+            break
         d = solve_with(-grad)
         slope = float(jnp.dot(grad, d))
         alpha, accepted = 1.0, False
