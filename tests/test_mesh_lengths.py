@@ -180,3 +180,35 @@ def test_one_connectivity_type_for_meshes_and_intrinsic_triangulations():
     assert dg.mesh.euler_characteristic(flipped.connectivity) == 0 and dg.mesh.is_orientable(flipped.connectivity)
     np.testing.assert_allclose(np.asarray(lengths.angle_defects(flipped.connectivity, T.opposite_side_lengths(flipped))),
                                np.asarray(dg.mesh.angle_defect(V * [6.0, 1, 1], F)), atol=1e-12)
+
+
+@pytest.mark.parametrize("sides", [(1.0, 1.0, 1.0), (1.0, 1.0, 0.5), (0.5, 1.0, 1.0), (1.0, 0.5, 1.0), (1.2, 1.0, 0.7)])
+def test_heron_gradient_is_right_at_ties_of_the_sorted_sides(sides):
+    """∂A/∂a = a (b² + c² − a²) / (8A) (differentiate 16A² = 2a²b² + 2b²c² + 2c²a² − a⁴ − b⁴ − c⁴),
+    also at the three-way tie of an equilateral triangle, where composing max/min split the
+    derivative (weights 0.875, 0.875, 1.25 per side).  Negative control: the unequal case."""
+    import jax
+    import jax.numpy as jnp
+
+    a, b, c = sides
+    area = lengths.triangle_area(a, b, c)
+    expected = np.array([s * (t**2 + u**2 - s**2) for s, t, u in ((a, b, c), (b, c, a), (c, a, b))]) / (8 * area)
+    gradient = jax.grad(lambda l: lengths.triangle_area(l[0], l[1], l[2]))(jnp.array(sides))
+    assert np.abs(np.asarray(gradient) - expected).max() < 1e-15
+
+
+def test_simplicial_area_gradient_on_the_octahedron_with_exactly_equilateral_faces():
+    """The octahedron ±e_k: every side is computed as √2 exactly (a three-way tie in every face).
+    Moving vertex e_1 to s e_1 makes each of its 4 faces ½|(1, s, s)| = ½ √(1 + 2s²), so
+    ∇_{v} A = (4/√3) v at every vertex (Thm 6.7's mean-curvature normal, here by symmetry)."""
+    import jax
+    import jax.numpy as jnp
+
+    from energies import area
+
+    V, F = dg.mesh.builtin.octahedron()
+    sides = np.linalg.norm(V[F] - V[np.roll(F, 1, axis=1)], axis=2)
+    assert np.all(sides == sides[0, 0])  # exact ties
+    problem = area.simplicial(V, F)
+    gradient = np.asarray(jax.grad(problem.energy)(jnp.asarray(V, dtype=jnp.float64), problem.params))
+    assert np.abs(gradient - 4 / np.sqrt(3) * V).max() < 1e-14

@@ -162,12 +162,23 @@ def check_face_areas(sin2, F) -> None:
 
 
 def _sorted3(a, b, c):
-    """(x, y, z) with x ≥ y ≥ z elementwise, exactly (min / max only, no arithmetic)."""
+    """(x, y, z) with x ≥ y ≥ z elementwise: a permutation of (a, b, c), selected (no arithmetic),
+    ties broken by position (NaN if a side is NaN).  Selecting, rather than composing min / max, keeps the derivative of
+    a symmetric function of the sorted sides right at ties: `max` splits its derivative between
+    equal arguments, which at a three-way tie (an equilateral triangle) gives per-side weights
+    that do not sum to 1."""
     xp = _xp(a, b, c)
-    x = xp.maximum(xp.maximum(a, b), c)
-    z = xp.minimum(xp.minimum(a, b), c)
-    y = xp.maximum(xp.minimum(a, b), xp.minimum(xp.maximum(a, b), c))
-    return x, y, z
+    a, b, c = (xp.asarray(t) for t in (a, b, c))  # Python floats: `~` of a bool is an int
+    ab, ac, bc = a >= b, a >= c, b >= c  # "ranks above", a total order with ties broken by position
+    a_first, b_first = ab & ac, ~ab & bc
+    c_last, b_last = ac & bc, ab & ~bc
+    x = xp.where(a_first, a, xp.where(b_first, b, c))
+    z = xp.where(c_last, c, xp.where(b_last, b, a))
+    a_middle = ~a_first & ~(~c_last & ~b_last)
+    b_middle = ~b_first & ~b_last & ~a_middle
+    y = xp.where(a_middle, a, xp.where(b_middle, b, c))
+    nan = xp.isnan(a) | xp.isnan(b) | xp.isnan(c)  # comparisons with NaN are False: keep NaN sides NaN
+    return tuple(xp.where(nan, a + b + c, t) for t in (x, y, z))
 
 
 def triangle_area(a, b, c):
