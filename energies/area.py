@@ -53,8 +53,9 @@ from ddgjax.mesh.lengths import squared_side_lengths, triangle_area
 
 from .dirichlet import dirichlet_solve
 
-__all__ = ["METHODS", "face_area", "harmonic_iteration", "interior_residual", "minimal_surface",
-           "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial"]
+__all__ = ["METHODS", "cap_volume", "cone_volume", "enclosed_volume", "face_area", "face_volume", "harmonic_iteration",
+           "interior_residual", "minimal_surface", "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial",
+           "with_volume"]
 
 METHODS = ("auto", "cotan", "newton", "delaunay")
 LOOSE_TOL = 1e-4  # the "auto" method's switch from Fig 6.5 to Newton, relative to the boundary's size
@@ -340,3 +341,128 @@ def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1
             residual=info["residual"], steps=info["iterations"],
         )
     return V_min, F, info
+
+
+# ---------------------------------------------------------------------------------------------
+# Soap bubbles: the area with prescribed enclosed volume (constant mean curvature, Laplace–Young)
+
+
+def face_volume(P: Float[Array, "3 3"], params=None) -> Float[Array, ""]:
+    """det(v0, v1, v2)/6: the signed volume of the cone from the origin over the face."""
+    import jax.numpy as jnp
+
+    return jnp.linalg.det(P) / 6.0
+
+
+def cone_volume(P: Float[Array, "3 3"], share, params) -> Float[Array, "1"]:
+    """The density of the named constraint `"volume"` of `with_volume`, one face's share of
+    vol(S) − volume: `face_volume`, plus the face's `share` (1/nf) of `cap − params["volume"]`
+    (shape (1,))."""
+    return (face_volume(P) + share["weight"] * (share["cap"] - params["volume"]))[None]
+
+
+def _boundary_halfedges(F: np.ndarray) -> np.ndarray:
+    """(k, 2): the halfedges (a, b), as the faces of F run through them, without a twin (b, a)."""
+    he = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
+    n = int(F.max()) + 1
+    return he[~np.isin(he[:, 1] * n + he[:, 0], he[:, 0] * n + he[:, 1])]
+
+
+def cap_volume(V, F) -> float:
+    """The signed volume of the cones from the origin over the flat caps that close the boundary
+    loops of (V, F): each loop is coned off from its centroid c, by the triangles (c, b, a) for its
+    boundary halfedges (a, b) (reversed, so surface and caps are consistently oriented); 0 for a
+    closed mesh.  With it, Σ_F det/6 + cap is the volume enclosed by the surface closed by its caps,
+    independent of the origin."""
+    V, F = np.asarray(V, dtype=np.float64), np.asarray(F)
+    edges = _boundary_halfedges(F)
+    if not edges.size:
+        return 0.0
+    centroid = np.zeros_like(V)
+    for loop in dg.mesh.boundary_loops(F):
+        centroid[loop] = V[loop].mean(axis=0)
+    a, b = V[edges[:, 0]], V[edges[:, 1]]
+    return float(np.einsum("ij,ij->i", centroid[edges[:, 0]], np.cross(b, a)).sum() / 6.0)
+
+
+def enclosed_volume(V, F) -> float:
+    """vol(S) = Σ_F det(v0, v1, v2)/6 + `cap_volume(V, F)`: the volume enclosed by the oriented
+    surface (V, F) (closed by flat caps over its boundary loops), positive when the normals
+    (v1 − v0) × (v2 − v0) point out of it."""
+    V, F = np.asarray(V, dtype=np.float64), np.asarray(F)
+    return float(np.linalg.det(V[F]).sum() / 6.0) + cap_volume(V, F)
+
+
+def _check_bubble(V: np.ndarray, F: np.ndarray, fixed: np.ndarray) -> None:
+    """The checks `with_volume` adds to `simplicial`'s: F consistently oriented, the boundary
+    loops fixed, the normals pointing out of the enclosed volume."""
+    from ddgjax.errors import OrientationError
+    from ddgjax.mesh.connectivity import glue_triangles
+
+    glue_triangles(F, len(V))  # OrientationError naming an edge two faces run through alike
+    loop_vertices = np.unique(_boundary_halfedges(F))
+    loose = loop_vertices[~fixed[loop_vertices]]
+    if loose.size:
+        raise InvalidInputError(
+            f"with_volume: vertex {loose[0]} lies on a boundary loop of F but is not fixed: the volume enclosed by "
+            "a surface with boundary is measured with flat caps over its boundary loops, which must stay put")
+    vol0 = enclosed_volume(V, F)
+    if vol0 < 0:
+        raise OrientationError(
+            f"with_volume: the enclosed volume of the start is {vol0:.6g} < 0: the faces of F are oriented "
+            "inward; the volume is measured with the normals (v1 − v0) × (v2 − v0) pointing out of it, so "
+            "reverse the faces (F[:, ::-1])")
+
+
+def with_volume(V, F, volume, boundary=None) -> dg.Problem:
+    """Soap bubbles: the area A(S) = Σ_F A(F) of the triangle mesh (V, F) as a functional of the
+    vertex positions (nv, 3), with the enclosed volume prescribed, the named constraint
+
+        "volume":  vol(S) − volume = 0,   vol(S) = (1/6) Σ_F det(v0, v1, v2) + cap,
+
+    (F oriented, normals (v1 − v0) × (v2 − v0) pointing out of the volume).  For a closed mesh
+    cap = 0 and vol(S) is the enclosed volume (divergence theorem: the cones from the origin over
+    the faces).  For a mesh with boundary (vertices `boundary` fixed; default: the vertices on
+    boundary edges, which must all be fixed) Σ_F det/6 alone is the signed volume of the cone
+    from the origin over S; `cap = cap_volume(V, F)`, a constant since the boundary is fixed,
+    adds the cones over flat caps closing each boundary loop from its centroid, so vol(S) is
+    the volume enclosed by S and its caps, independent of the origin (a liquid bridge between
+    two coaxial circles: the volume between the surface and the two disks).
+
+    Critical points: ∇A = p ∇vol with the multiplier p = `solve(problem).multipliers["volume"]`
+    (`dg.Problem`'s sign: critical points of A − p (vol − volume)).  Thm 6.7: ∇_{f(i)} A = (L f)(i),
+    the cotan Laplacian of the surface applied to its positions, the discrete mean curvature
+    normal, 2H N times the vertex area as h → 0, while ∇_{f(i)} vol is the vertex area times N
+    (⅓ of the area-weighted normals of the faces at i).  So the critical points are the discrete
+    surfaces of constant mean curvature 2H = κ1 + κ2 = p, and p is the pressure difference across
+    the film of the Laplace–Young law Δp = σ(κ1 + κ2) (surface tension σ = 1): round sphere of
+    radius r, p = 2/r (area 4πr², volume 4πr³/3, dA/dvol = 2/r); cylinder of radius R, p = 1/R.
+    On a convex bubble both gradients point out, so p > 0.  p is also the derivative of the
+    critical area in the prescribed volume, dA/d(volume) = p (the envelope theorem).
+
+    A closed bubble is free to translate and rotate (area and volume are invariant): its KKT
+    matrix has a 6-dimensional kernel.  Nothing pins it: `solve`'s regularised Newton steps
+    (μ = 1e-14 and LM, `solvers/_newton.py`) converge on such a family of solutions, to one member
+    near the start.  As for `simplicial`, the tangential motions of the vertices are nearly flat
+    for the area: start close (a sphere with a few percent of smooth perturbation converges in a
+    few steps; a coarse start far away may stall, where the default `warm_start` retries).
+
+    **Arguments:** `V` (nv, 3), `F` (nf, 3) consistently oriented; `volume` the enclosed volume
+    (finite, > 0; `params={"volume": volume}`, so `jax.grad` of `solve(...).energy` in it is the
+    pressure); `boundary` fixed vertex indices or an (nv,) bool mask.
+
+    **Raises:** the errors of `simplicial`; `OrientationError` (two faces running through an edge
+    alike, naming it, or the normals pointing into the volume: reverse F); `InvalidInputError`
+    (`volume` not finite and positive, or a boundary-loop vertex not fixed, naming it).
+    """
+    from ddgjax._checks import check_positive
+
+    V, F, b = _checked(V, F, boundary)
+    check_positive(volume, "with_volume: volume")
+    fixed = _mask(b, len(V))
+    _check_bubble(V, F, fixed)
+    share = {"weight": np.full(len(F), 1.0 / len(F)), "cap": np.full(len(F), cap_volume(V, F))}
+    return dg.Problem(dg.local_sum(face_area, F), V,
+                      constraints=dg.concat(volume=dg.local_sum(cone_volume, F, data=share)),
+                      params={"volume": float(volume)}, fixed=np.repeat(fixed[:, None], 3, axis=1),
+                      name=f"area with volume {float(volume):.6g} (nv={len(V)}, nf={len(F)})")

@@ -11,8 +11,9 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", "pendulum_shooting", "catenoid",
         "intrinsic_delaunay", "narrow_minimal_surface"]
-# the rod's KKT system takes minutes to compile on 2 cores: run with `make test-all`
-SLOW = ["twisted_rod"]
+# the rod's KKT system takes minutes to compile on 2 cores, the bubbles' three KKT systems ~20 s
+# (their physics is checked by `ddgjax verify`, ext_bubbles): run with `make test-all`
+SLOW = ["twisted_rod", "soap_bubble"]
 
 
 def load(name: str):
@@ -44,6 +45,8 @@ SHOWN = {
     "intrinsic_delaunay_ellipsoid.png": [("rectilinear", 0, EDGES)] * 2 + [("rectilinear", 1, [])],
     "narrow_minimal_surface.png": [("3d", 0, ["Poly3DCollection"])] * 3 + [("rectilinear", 2, [])],
     "twisted_rod.png": [("3d", 3, [])],
+    "soap_bubble.png": [("3d", 0, ["Poly3DCollection"]), BAR],
+    "liquid_bridges.png": [("rectilinear", 2, [])],
 }
 
 

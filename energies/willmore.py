@@ -1,0 +1,271 @@
+"""Willmore and Helfrich energies of closed simplicial surfaces (Sec 6.4, Thm 6.7; Bobenko 2005).
+
+**Helfrich** (`helfrich`).  W(S) = κ Σ_i (H_i − H₀)² A_i over the vertices, with the discrete mean
+curvature *derived from the area*: by Thm 6.7 the area gradient at a vertex is the
+mean-curvature normal times the vertex area, ∇_i A = (L f)(i) ≈ 2 H N A_i, so
+
+    H_i = ⟨∇_i A, N_i⟩ / (2 A_i),   N_i = ∇_i Vol / |∇_i Vol|,   A_i = ⅓ Σ_{f ∋ i} A(f),
+
+N_i the unit (area-weighted) normal, from the gradient of the enclosed volume
+Vol = Σ_f det(v0, v1, v2)/6, and A_i the barycentric vertex area.  ∇_i A and ∇_i Vol are taken
+by `jax.grad` of the area and volume of the star of i inside the density (no cotan formula), so
+H_i is exactly the cotan mean curvature ⟨(L f)(i), N_i⟩ / 2A_i.  Convention H = (κ₁ + κ₂)/2 with
+the outward normal of a positively oriented closed surface (Vol > 0): a round sphere of radius r
+has H = 1/r and W = 4π for κ = 1, H₀ = 0 (Willmore's theorem: W ≥ 4π, equality for round spheres).
+W with H₀ = 0 is scale invariant; H₀ ≠ 0 depends on the orientation (H changes sign with it).
+
+Measured on icospheres (levels 1–5): W − 4π = −0.862, −0.222, −0.0559, −0.0140, −0.0035, order 2
+in the edge length and from below (the discrete W of an icosphere is < 4π: the discrete Willmore
+inequality fails for this energy).  H converges in the mean (∫|H − 1| dA at order ~2) but not
+pointwise: at the 12 valence-5 vertices |H − 1| → 0.146 (barycentric areas on an irregular mesh).
+icosphere(1) is a critical point under its own area and volume (λ_A = 8.194, λ_V = −17.417,
+2Aλ_A + 3Vol λ_V = 0 by scale invariance); the icospheres are not critical for W alone.
+
+The energy is declared with `dg.local_sum` over the vertex stars: the stencil of vertex i is i and
+its link vertices, padded to the largest valence with copies of i (the padded faces are masked
+out), so the sparse solvers apply (the Hessian couples vertices at combinatorial distance ≤ 2).
+Constraints (optional, named): `"area"`: A(S) − area, `"volume"`: Vol(S) − volume, each a
+`dg.local_sum` over the faces; their multipliers are the surface tension and the pressure
+(∇W = λ_A ∇A + λ_V ∇Vol at a critical point).
+
+**Conformal** (`conformal`).  Bobenko's discrete Willmore energy ("A conformal energy for
+simplicial surfaces", 2005): W(S) = Σ_e β_e − π |V| on a closed surface, β_e ∈ [0, π] the
+exterior intersection angle of the circumcircles of the two triangles at the edge e.  It is
+invariant under Möbius transformations of R³, W = Σ_v W(v)/2 with W(v) = Σ_{e ∋ v} β_e − 2π ≥ 0,
+and W(v) = 0 iff the star of v is convex and inscribed in a sphere.
+
+β_e from the four vertices: for the edge (i, j) between the triangles (i, j, k) and (j, i, l),
+invert in the unit sphere about x_i, p ↦ (p − x_i)/|p − x_i|²: both circles pass through x_i, so
+they become the lines (j'k') and (j'l'), and the angle between circles is the angle between the
+lines (inversion is conformal).  The exterior angle is the turning angle of the polyline
+k' → j' → l' (zero when the four points are concyclic with k and l on opposite arcs of the chord ij):
+
+    β_e = ∠(j' − k', l' − j'),   p' = (p − x_i)/|p − x_i|²,
+
+evaluated with the vectors scaled by |x_j − x_i|² (a = x_j − x_i, b = x_k − x_i, c = x_l − x_i:
+u = a − b |a|²/|b|², w = c |a|²/|c|² − a, β = atan2(|u × w|, u·w)), so all terms are of the size
+of the edge.  Declared with `dg.local_sum` over the edges (stencil (i, j, k, l)); the constant
+−π|V| is spread over the edges as per-edge data.  The energy has the Möbius group as a
+10-dimensional family of zero modes, so `solve` on it is singular; it is a functional to
+evaluate, differentiate and use in flows.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+import ddgjax as dg
+from ddgjax.errors import InvalidInputError, MeshError, OrientationError
+from ddgjax.laplace import check_nondegenerate, checked_triangle_mesh
+from ddgjax.mesh import boundary_vertices
+
+from .area import face_area, face_volume
+
+__all__ = ["circle_angle", "circle_angles", "conformal", "edge_stencil", "helfrich", "mean_curvature",
+           "star_stencil", "vertex_density"]
+
+
+# ---------------------------------------------------------------------------------------------
+# meshes: closed, oriented; stencils
+
+
+def _closed(V, F) -> tuple[np.ndarray, np.ndarray]:
+    V, F = checked_triangle_mesh(V, F, manifold=True)
+    check_nondegenerate(V, F)
+    b = boundary_vertices(F, V.shape[0])
+    if b.size:
+        raise InvalidInputError(f"the Willmore energies need a closed surface; vertex {int(b[0])} lies on a boundary edge")
+    unused = np.flatnonzero(np.bincount(F.ravel(), minlength=len(V)) == 0)
+    if unused.size:
+        raise MeshError(f"vertex {int(unused[0])} is in no face: remove unreferenced vertices")
+    return V, F
+
+
+def _halfedges(F: np.ndarray):
+    """Tails, heads and opposite corners of the 3·nf halfedges (face-major), and the index of the
+    twin of each (a closed, consistently oriented surface)."""
+    tail, head, opp = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1), np.roll(F, -2, axis=1).reshape(-1)
+    nv = int(F.max()) + 1
+    key = tail * nv + head
+    twin_key = head * nv + tail
+    order = np.argsort(key)
+    pos = np.searchsorted(key[order], twin_key)
+    pos = np.minimum(pos, key.size - 1)
+    twin = order[pos]
+    bad = np.flatnonzero(key[twin] != twin_key)
+    if bad.size:
+        h = int(bad[0])
+        raise OrientationError(f"edge ({int(tail[h])}, {int(head[h])}) of face {h // 3} is traversed in the same "
+                               "direction by both of its faces: orient the surface consistently")
+    return tail, head, opp, twin
+
+
+def edge_stencil(F) -> np.ndarray:
+    """(ne, 4) rows (i, j, k, l): the edge (i, j) between the triangles (i, j, k) and (j, i, l) of
+    the closed, consistently oriented surface F, each edge once.
+
+    **Raises:** `OrientationError` naming an edge traversed twice in the same direction."""
+    tail, head, opp, twin = _halfedges(np.asarray(F, dtype=np.int64))
+    h = np.flatnonzero(tail < head)
+    return np.stack([tail[h], head[h], opp[h], opp[twin[h]]], axis=1)
+
+
+def star_stencil(F, nv: int) -> tuple[np.ndarray, dict]:
+    """The vertex stars as a `dg.local_sum` stencil: `(stencil, data)`, stencil (nv, 1 + m) =
+    (i, link vertices of i, padded with i), m the largest valence; data `{"faces": (nv, m, 2)`
+    local indices (a, b) of the star's triangles (i, a, b) in the orientation of F, `"mask": (nv, m)`
+    1 for a triangle, 0 for padding (a copy of the first triangle)}."""
+    tail, head, opp, _ = _halfedges(np.asarray(F, dtype=np.int64))  # corner (tail, head, opp) seen from tail
+    order = np.argsort(tail, kind="stable")
+    tail, head, opp = tail[order], head[order], opp[order]  # grouped by centre vertex
+    valence = np.bincount(tail, minlength=nv)
+    m = int(valence.max())
+    slot = np.arange(tail.size) - np.concatenate([[0], np.cumsum(valence)[:-1]])[tail]  # rank in its star
+    stencil = np.repeat(np.arange(nv)[:, None], 1 + m, axis=1)
+    stencil[tail, 1 + slot] = head  # on a closed surface the heads of a star are its link, each once
+    key = tail * nv + head  # the opposite corner opp is the head of another corner of the same star
+    by_key = np.argsort(key)
+    faces = np.zeros((nv, m, 2), dtype=np.int64)
+    faces[tail, slot, 0] = 1 + slot
+    faces[tail, slot, 1] = 1 + slot[by_key[np.searchsorted(key[by_key], tail * nv + opp)]]
+    mask = np.zeros((nv, m))
+    mask[tail, slot] = 1.0
+    pad = mask == 0
+    faces[pad] = np.repeat(faces[:, :1], m, axis=1)[pad]
+    return stencil, {"faces": faces, "mask": mask}
+
+
+# ---------------------------------------------------------------------------------------------
+# Helfrich: the mean curvature derived from the area and the volume
+
+
+def _star_measures(X, star):
+    """(∇_i A, ∇_i Vol, A_i) of the star of vertex i = X[0]: gradients by `jax.grad` of the star's
+    area and volume with respect to the centre, in coordinates centred at x_i (the star is closed,
+    so both gradients are translation invariant)."""
+    R = X - X[0]
+    a, b = R[star["faces"][:, 0]], R[star["faces"][:, 1]]
+
+    def measures(q):
+        P = jnp.stack([jnp.broadcast_to(q, a.shape), a, b], axis=1)
+        area = jnp.sum(star["mask"] * jax.vmap(face_area)(P))
+        volume = jnp.sum(star["mask"] * jax.vmap(face_volume)(P))
+        return area, volume
+
+    zero = jnp.zeros(3, dtype=X.dtype)
+    (grad_area, grad_volume) = jax.jacrev(measures)(zero)
+    return grad_area, grad_volume, measures(zero)[0] / 3.0
+
+
+def _mean_curvature_of_star(X, star):
+    grad_area, grad_volume, vertex_area = _star_measures(X, star)
+    normal = grad_volume / jnp.linalg.norm(grad_volume)
+    return jnp.dot(grad_area, normal) / (2.0 * vertex_area), vertex_area
+
+
+def vertex_density(X: Float[Array, "s 3"], star: dict, params: dict) -> Float[Array, ""]:
+    """κ (H_i − H₀)² A_i of the star of i = X[0] (`star_stencil`)."""
+    H, vertex_area = _mean_curvature_of_star(X, star)
+    return params["kappa"] * (H - params["H0"]) ** 2 * vertex_area
+
+
+def mean_curvature(V, F) -> tuple[np.ndarray, np.ndarray]:
+    """`(H, A)`: the discrete mean curvature H_i = ⟨∇_i A, N_i⟩ / 2A_i and the barycentric vertex
+    area A_i of the closed surface (V, F), (nv,) each (module docstring).
+
+    **Raises:** as `helfrich`."""
+    V, F = _closed(V, F)
+    stencil, data = star_stencil(F, len(V))
+    H, A = _mean_curvatures(jnp.asarray(V)[stencil], jax.tree_util.tree_map(jnp.asarray, data))
+    return np.asarray(H), np.asarray(A)
+
+
+_mean_curvatures = jax.jit(jax.vmap(_mean_curvature_of_star))
+
+
+def _area_constraint(P, share, params):
+    return jnp.reshape(face_area(P) - share * params["area"], (1,))
+
+
+def _volume_constraint(P, share, params):
+    return jnp.reshape(face_volume(P) - share * params["volume"], (1,))
+
+
+def helfrich(V, F, *, kappa: float = 1.0, H0: float = 0.0, area: float | None = None,
+             volume: float | None = None) -> dg.Problem:
+    """The Helfrich energy W = κ Σ_i (H_i − H₀)² A_i of the closed surface (V, F) as a functional
+    of the vertex positions (nv, 3) (module docstring; κ = 1, H₀ = 0: the Willmore energy ∫H² dA,
+    4π on round spheres).  `params = {"kappa", "H0"[, "area"][, "volume"]}`.
+
+    **Constraints** (named, only those given): `"area"`: A(S) − area, `"volume"`: Vol(S) − volume
+    (shape (1,) each); the multipliers are `{"area": (1,), "volume": (1,)}`.
+
+    **Raises:** `NonFiniteError`, `MeshError` / `NonManifoldError` (as `area.simplicial`),
+    `DegenerateFaceError` (a zero-area face), `InvalidInputError` (a boundary: the surface must be
+    closed), `OrientationError` (faces not consistently oriented).
+    """
+    V, F = _closed(V, F)
+    stencil, data = star_stencil(F, len(V))
+    params = {"kappa": float(kappa), "H0": float(H0)}
+    named = {}
+    share = np.full(len(F), 1.0 / len(F))
+    if area is not None:
+        params["area"] = float(area)
+        named["area"] = dg.local_sum(_area_constraint, F, share)
+    if volume is not None:
+        params["volume"] = float(volume)
+        named["volume"] = dg.local_sum(_volume_constraint, F, share)
+    constraints = dg.locality.concat(**named) if named else None
+    return dg.Problem(dg.local_sum(vertex_density, stencil, data), V, constraints=constraints, params=params,
+                      name=f"Helfrich energy (nv={len(V)}, nf={len(F)})")
+
+
+# ---------------------------------------------------------------------------------------------
+# Bobenko's conformal energy
+
+
+def _norm(v):
+    """|v| with a finite gradient at v = 0 (β = 0 or π exactly)."""
+    s = jnp.dot(v, v)
+    safe = jnp.where(s > 0, s, 1.0)
+    return jnp.where(s > 0, jnp.sqrt(safe), 0.0)
+
+
+def circle_angle(X: Float[Array, "4 3"], params=None) -> Float[Array, ""]:
+    """β_e ∈ [0, π]: the exterior intersection angle of the circumcircles of the triangles
+    (x_i, x_j, x_k) and (x_j, x_i, x_l), X = (x_i, x_j, x_k, x_l), by inversion about x_i
+    (module docstring)."""
+    a, b, c = X[1] - X[0], X[2] - X[0], X[3] - X[0]
+    aa = jnp.dot(a, a)
+    u = a - b * (aa / jnp.dot(b, b))  # |a|² (j' − k')
+    w = c * (aa / jnp.dot(c, c)) - a  # |a|² (l' − j')
+    return jnp.arctan2(_norm(jnp.cross(u, w)), jnp.dot(u, w))
+
+
+def _edge_density(X, offset, params):
+    return circle_angle(X) - offset
+
+
+def circle_angles(V, F) -> tuple[np.ndarray, np.ndarray]:
+    """`(edges, β)`: the `edge_stencil` (ne, 4) of the closed surface (V, F) and the angles β_e (ne,)."""
+    V, F = _closed(V, F)
+    E = edge_stencil(F)
+    return E, np.asarray(_circle_angles(jnp.asarray(V)[E]))
+
+
+_circle_angles = jax.jit(jax.vmap(circle_angle))
+
+
+def conformal(V, F) -> dg.Problem:
+    """Bobenko's conformal (Möbius-invariant) Willmore energy W = Σ_e β_e − π|V| of the closed
+    surface (V, F), a functional of the vertex positions (nv, 3); W ≥ 0, = 0 iff every vertex star
+    is convex and inscribed in a sphere (module docstring).
+
+    **Raises:** as `helfrich`."""
+    V, F = _closed(V, F)
+    E = edge_stencil(F)
+    offset = np.full(len(E), np.pi * len(V) / len(E))
+    return dg.Problem(dg.local_sum(_edge_density, E, offset), V, name=f"conformal Willmore energy (nv={len(V)}, nf={len(F)})")
