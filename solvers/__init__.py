@@ -17,5 +17,8 @@ from ._linear import LinearSolver as LinearSolver
 from ._minimize import minimize as minimize
 from ._solve import Solution as Solution
 from ._solve import solve as solve
+from ._stability import Stability as Stability
+from ._stability import stability as stability
 
-__all__ = ["solve", "minimize", "solve_batch", "Solution", "LinearSolver", "DenseLU", "KLU", "SparseDirect", "Krylov"]
+__all__ = ["solve", "minimize", "solve_batch", "Solution", "LinearSolver", "DenseLU", "KLU", "SparseDirect", "Krylov",
+           "stability", "Stability"]
