@@ -17,6 +17,8 @@ a gluing word ("abAB") or `Halfedges`.  Surfaces may be non-orientable and have 
   `corner_angles_from_lengths`, `angle_defect_from_lengths`, `corner_cotangents`,
   `dirichlet_energy`, `stiffness`
 - io: `read`, `write` (meshio)
+- subdivision: `subdivide` (midpoint or Loop, old vertices first), `subdivision_matrix` (the
+  sparse prolongation S, V' = S V, also for warm starts)
 - cleanup (each returns `(V, F, CleanupReport)`): `remove_unreferenced_vertices`, `weld_vertices`,
   `split_nonmanifold_vertices`, `drop_degenerate_faces`
 """
@@ -141,6 +143,8 @@ from .lengths import (
 from .lengths import (
     edge_lengths as edge_lengths,
 )
+from .subdivision import subdivide as subdivide
+from .subdivision import subdivision_matrix as subdivision_matrix
 from .topology import (
     Classification as Classification,
 )

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InvalidInputError
+from .subdivision import subdivide
 
 __all__ = [
     "tetrahedron",
@@ -97,24 +98,12 @@ def _hull_faces(V) -> np.ndarray:
     return F
 
 
-def _subdivide(V, F):
-    """Split each triangle into four at its edge midpoints (vectorised with unique edges)."""
-    nv = V.shape[0]
-    he = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
-    edges, mid = np.unique(np.sort(he, axis=1), axis=0, return_inverse=True)
-    mid = mid.reshape(-1, 3) + nv
-    V = np.vstack([V, 0.5 * (V[edges[:, 0]] + V[edges[:, 1]])])
-    a, b, c = F.T
-    ab, bc, ca = mid.T
-    F = np.concatenate([np.stack(t, axis=1) for t in ([a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca])])
-    return V, F
-
-
 def icosphere(level: int = 1):
-    """The icosahedron subdivided `level` times (20·4^level faces), projected to the unit sphere."""
+    """The icosahedron subdivided `level` times (20·4^level faces, `subdivide`, midpoints),
+    each time projected to the unit sphere."""
     V, F = icosahedron()
     for _ in range(level):
-        V, F = _subdivide(V, F)
+        V, F = subdivide(V, F)
         V = V / np.linalg.norm(V, axis=1, keepdims=True)
     return _mesh(V, F)
 
