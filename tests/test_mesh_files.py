@@ -106,7 +106,11 @@ MALFORMED = {
     "noxyz.ply": (HEADER_PLY.replace(b" z\n", b" w\n") % (b"ascii", 3) + FACE_PLY % 1 + b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
                   "no element 'vertex' with properties x, y, z"),
     "format.ply": (b"ply\nformat ascii 2.0\nend_header\n", "unexpected PLY header line 'format ascii 2.0'"),
-    "polydata.vtk": (b"# vtk DataFile Version 4.2\nm\nASCII\nDATASET POLYDATA\n", "only UNSTRUCTURED_GRID is read"),
+    "polydata.vtk": (b"# vtk DataFile Version 4.2\nm\nASCII\nDATASET POLYDATA\n", "the POLYDATA has no POINTS section"),
+    "grid.vtk": (b"# vtk DataFile Version 4.2\nm\nASCII\nDATASET STRUCTURED_POINTS\n",
+                 "only UNSTRUCTURED_GRID and POLYDATA are read"),
+    "counts.vtk": (b"# vtk DataFile Version 4.2\nm\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                   b"POLYGONS 2 5\n3 0 1 2 7\n", "promises 2 polygons in 5 numbers, which do not add up"),
     "garbage.msh": (b"not a mesh at all", "Couldn't read file"),
 }
 
@@ -219,6 +223,34 @@ def test_mixed_triangles_and_quads_come_back_as_polygons(tmp_path, suffix):
     V, F = mesh.read(tmp_path / f"m{suffix}")
     assert np.array_equal(V, MIXED_V) and F == MIXED_F
     assert mesh.euler_characteristic(F) == 1
+
+
+def _polydata(encoding: bytes, points: bytes, polygons: bytes) -> bytes:
+    return b"# vtk DataFile Version 3.0\nm\n" + encoding + b"\nDATASET POLYDATA\n" + points + polygons
+
+
+def test_vtk_polydata_with_a_polygon_of_many_corners(tmp_path):
+    """POLYDATA as ParaView writes it: classic ascii and big-endian binary (`POLYGONS n size`, each
+    polygon its corner count then its corners) and the VTK 5.1 layout (OFFSETS, CONNECTIVITY); a
+    200-gon (more corners than a signed byte counts) next to a triangle."""
+    n = 200
+    t = 2 * np.pi * np.arange(n) / n
+    V = np.column_stack([np.cos(t), np.sin(t), np.zeros(n)]).astype(np.float32).astype(np.float64)
+    F = [list(range(n)), [0, 1, 2]]
+    flat = np.array([n, *range(n), 3, 0, 1, 2])
+    ascii_points = b"POINTS %d float\n" % n + " ".join(map(repr, V.ravel().tolist())).encode() + b"\n"
+    files = {
+        "ascii.vtk": _polydata(b"ASCII", ascii_points,
+                               b"POLYGONS 2 %d\n" % flat.size + " ".join(map(str, flat)).encode() + b"\n"),
+        "binary.vtk": _polydata(b"BINARY", b"POINTS %d float\n" % n + V.astype(">f4").tobytes() + b"\n",
+                                b"POLYGONS 2 %d\n" % flat.size + flat.astype(">i4").tobytes() + b"\n"),
+        "v51.vtk": _polydata(b"ASCII", ascii_points, b"POLYGONS 3 %d\nOFFSETS vtktypeint64\n0 %d %d\n"
+                             b"CONNECTIVITY vtktypeint64\n" % (n + 3, n, n + 3)
+                             + " ".join(map(str, [*range(n), 0, 1, 2])).encode() + b"\n"),
+    }
+    for name, data in files.items():
+        V2, F2 = mesh.read(_write(tmp_path, name, data))
+        assert np.array_equal(V2, V) and F2 == F, name
 
 
 def test_polygons_keep_the_order_of_the_file(tmp_path):

@@ -396,13 +396,14 @@ def _unique_rows(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 _VTK_BYTES = {"bit": 1, "unsigned_char": 1, "char": 1, "unsigned_short": 2, "short": 2, "unsigned_int": 4,
               "int": 4, "unsigned_long": 8, "long": 8, "float": 4, "double": 8, "vtktypeint64": 8,
               "vtktypeuint64": 8, "vtkidtype": 4}
-_VTK_DATASET = "UNSTRUCTURED_GRID"  # meshio reads no POLYDATA; structured grids make points from DIMENSIONS alone
+_VTK_DATASETS = ("UNSTRUCTURED_GRID", "POLYDATA")  # structured grids make points from DIMENSIONS alone
 
 
 def _read_vtk(path: Path, size: int):
-    """Legacy VTK, an UNSTRUCTURED_GRID: every count in a section line is checked against
-    the file size (an ascii number takes at least 2 bytes, a binary one its type's size), then
-    meshio reads the data."""
+    """Legacy VTK, an UNSTRUCTURED_GRID or POLYDATA: every count in a section line is checked
+    against the file size (an ascii number takes at least 2 bytes, a binary one its type's size),
+    then meshio reads an unstructured grid and `_read_polydata` the polygons of a POLYDATA."""
+    dataset = None
     with open(path, "rb") as f:
         if not _header_line(path, f).startswith("# vtk DataFile Version"):
             raise MeshFileError(path, "does not start with '# vtk DataFile Version'")
@@ -415,9 +416,74 @@ def _read_vtk(path: Path, size: int):
             if raw[:1].isalpha():  # data lines start with a digit, a sign or a binary byte
                 words = raw[:_LINE_LIMIT].decode("ascii", errors="replace").split()
                 per_item = _vtk_section(path, words, per_item, encoding == "BINARY", size)
+                dataset = words[1] if words[0] == "DATASET" and len(words) > 1 else dataset
+    if dataset == "POLYDATA":
+        return _read_polydata(path, encoding == "BINARY")
     import meshio.vtk
 
     return _meshio_cells(meshio.vtk.read(str(path)))
+
+
+def _vtk_array(path, data: bytes, start: int, count: int, type_name: str, binary: bool) -> tuple[np.ndarray, int]:
+    """`(values, end)`: `count` numbers of the VTK type `type_name` from `data[start:]` (binary:
+    big-endian, as legacy VTK writes them; ascii: whitespace-separated)."""
+    if binary:
+        kind = "f" if type_name in ("float", "double") else ("u" if type_name.startswith("unsigned") else "i")
+        width = _VTK_BYTES.get(type_name, 4)
+        end = start + count * width
+        if end > len(data):
+            raise MeshFileError(path, f"the file ends inside {count} {type_name} numbers (truncated)")
+        return np.frombuffer(data[start:end], dtype=f">{kind}{width}").astype(np.float64 if kind == "f" else np.int64), end
+    words = data[start:].split(maxsplit=count)
+    if len(words) < count:
+        raise MeshFileError(path, f"the file ends inside {count} {type_name} numbers (truncated)")
+    try:
+        values = np.array(words[:count], dtype=np.float64)
+    except ValueError:
+        raise MeshFileError(path, f"a {type_name} number of a section is not a number") from None
+    return values, len(data) - (len(words[count]) if len(words) > count else 0)
+
+
+def _vtk_section_at(data: bytes, key: bytes) -> re.Match | None:
+    return re.search(rb"(?m)^" + key + rb"[ \t]+([^\r\n]*)\r?\n", data)
+
+
+def _read_polydata(path: Path, binary: bool):
+    """`(points, sizes, corners)` of a legacy VTK POLYDATA: the POINTS and the POLYGONS, in the
+    classic layout (`POLYGONS n size`, then per polygon its corner count and corners) or the
+    layout of VTK 5.1 (`POLYGONS n_offsets n_connectivity`, then OFFSETS and CONNECTIVITY)."""
+    data = path.read_bytes()
+    points = _vtk_section_at(data, b"POINTS")
+    if points is None:
+        raise MeshFileError(path, "the POLYDATA has no POINTS section")
+    n, type_name = points.group(1).decode("ascii", errors="replace").split()[:2]
+    P, _ = _vtk_array(path, data, points.end(), 3 * int(n), type_name.lower(), binary)
+    polygons = _vtk_section_at(data, b"POLYGONS")
+    if polygons is None:
+        return P.reshape(-1, 3), np.zeros(0, np.int64), np.zeros(0, np.int64)
+    first, second = (int(w) for w in polygons.group(1).split()[:2])
+    offsets = _vtk_section_at(data[polygons.end():], b"OFFSETS")
+    if offsets is not None:  # VTK 5.1: offsets (n + 1) and connectivity
+        start = polygons.end() + offsets.end()
+        O, end = _vtk_array(path, data, start, first, offsets.group(1).decode().split()[0].lower(), binary)
+        connectivity = _vtk_section_at(data[end:], b"CONNECTIVITY")
+        if connectivity is None:
+            raise MeshFileError(path, "the POLYGONS have OFFSETS but no CONNECTIVITY")
+        C, _ = _vtk_array(path, data, end + connectivity.end(), second,
+                          connectivity.group(1).decode().split()[0].lower(), binary)
+        return P.reshape(-1, 3), np.diff(O.astype(np.int64)), C.astype(np.int64)
+    L, _ = _vtk_array(path, data, polygons.end(), second, "int", binary)
+    L = L.astype(np.int64)
+    sizes, heads, k = [], [], 0
+    while k < len(L):
+        sizes.append(int(L[k]))
+        heads.append(k)
+        k += 1 + int(L[k])
+    if k != len(L) or len(sizes) != first or min(sizes, default=1) < 0:
+        raise MeshFileError(path, f"the POLYGONS section promises {first} polygons in {second} numbers, which do not "
+                                  "add up (corrupt)")
+    corners = np.concatenate([L[h + 1:h + 1 + m] for h, m in zip(heads, sizes)] or [np.zeros(0, np.int64)])
+    return P.reshape(-1, 3), np.array(sizes, dtype=np.int64), corners
 
 
 _VTK_COUNTED = ("CELLS", "POLYGONS", "TRIANGLE_STRIPS", "LINES", "VERTICES", "CELL_TYPES", "POINT_DATA", "CELL_DATA",
@@ -449,9 +515,9 @@ def _vtk_section(path, words: list[str], per_item: int, binary: bool, size: int)
     at least 2 bytes, a binary one its type's size); returns the count of the current POINT_DATA
     or CELL_DATA (the length of the attribute arrays that follow)."""
     counts = [int(w) for w in words[1:] if re.fullmatch(r"-?\d+", w)]
-    if words[0] == "DATASET" and words[1:2] != [_VTK_DATASET]:
-        raise MeshFileError(path, f"holds the data set {' '.join(words[1:2])!r}; only {_VTK_DATASET} is read "
-                                  "(write the surface as an unstructured grid)")
+    if words[0] == "DATASET" and not set(words[1:2]) & set(_VTK_DATASETS):
+        raise MeshFileError(path, f"holds the data set {' '.join(words[1:2])!r}; only {' and '.join(_VTK_DATASETS)} "
+                                  "are read (write the surface as an unstructured grid or polydata)")
     if any(c < 0 for c in counts):
         raise MeshFileError(path, f"negative count in the line {' '.join(words)!r}")
     numbers = _vtk_numbers(words, counts, per_item)
