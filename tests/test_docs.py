@@ -149,7 +149,8 @@ API = [
     "ddgjax.limits.convergence", "ddgjax.limits.ConvergenceTable",
     "ddgjax.errors.DDGError", "ddgjax.errors.ConvergenceError",
     "solvers.solve", "solvers.Solution", "solvers.minimize", "solvers.solve_batch", "solvers.LinearSolver",
-    "solvers.DenseLU", "solvers.KLU", "solvers.SparseDirect", "solvers.Krylov",
+    "solvers.DenseLU", "solvers.KLU", "solvers.SparseDirect", "solvers.Krylov", "solvers.stability",
+    "solvers.Stability", "solvers.continuation", "solvers.Branch",
     *(f"ddgjax.curves.{f}" for f in ("tangents", "turning_angles", "curvature", "from_tangents", "tangent_flow",
                                      "heisenberg_flow")),
     *(f"ddgjax.quaternion.{f}" for f in ("mul", "conj", "inv", "rotate", "from_axis_angle", "to_matrix", "from_matrix")),
@@ -162,6 +163,8 @@ API = [
     "energies.elastica.clamped", "energies.elastica.closed", "energies.elastica.bending_energy",
     "energies.pendulum.action", "energies.pendulum.step", "energies.rod.clamped", "energies.heisenberg.hamiltonian",
     "energies.dirichlet.graph", "energies.dirichlet.cotan", "energies.area.simplicial", "energies.area.minimal_surface",
+    "energies.area.with_volume", "energies.willmore.helfrich", "energies.willmore.conformal",
+    "ddgjax.mesh.subdivision.subdivide",
     "ddgjax.verify.check", "ddgjax.verify.verify",
 ]
 
