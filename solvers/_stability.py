@@ -59,6 +59,8 @@ counted among them: exact unless a negative eigenvalue lies farther from 0 than 
 
 from __future__ import annotations
 
+import functools
+
 from functools import partial
 from typing import NamedTuple
 
@@ -312,6 +314,15 @@ def _projector(J):
     return project
 
 
+@functools.cache
+def _pardiso_handle():
+    """One symmetric-indefinite Pardiso handle per process, reused (freed by `_Inertia.close`):
+    constructing one looks up MKL's runtime, ~0.15 s."""
+    import pypardiso
+
+    return pypardiso.PyPardisoSolver(mtype=-2)
+
+
 class _Inertia:
     """`count(σ)`: #{eigenvalues of A on ker C below σ}, by the inertia of the bordered matrix
     `[[A − σI, Cᵀ], [C, 0]]` (its negative eigenvalues are that count + rank C) from Pardiso's
@@ -323,9 +334,7 @@ class _Inertia:
         self.A, self.C = A, C
         self.available = pardiso_available()
         if self.available:
-            import pypardiso
-
-            self.solver = pypardiso.PyPardisoSolver(mtype=-2)
+            self.solver = _pardiso_handle()
             self.solver.libmkl.MKL_Set_Num_Threads(PARDISO_THREADS)
 
     def count(self, shift: float) -> int:
