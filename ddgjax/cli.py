@@ -1,9 +1,10 @@
-"""The `ddgjax` command line: `verify`, `solve`, `bench`.
+"""The `ddgjax` command line: `verify`, `solve`, `sweep`, `bench`.
 
     ddgjax verify [--quick] [--out DIR] [--only WORD ...] [--list] [--debug]
     ddgjax solve elastica --n 100 --chord 0.5 0 0 --t-start 0 1 0 --t-end 0 -1 0 --plot out.png
     ddgjax solve rod --n 60 --alpha 0.7 --chord 0.6 0 0 --twist 2.5 --plot rod.png
     ddgjax solve minimal-surface --mesh annulus --height 0.4 --method cotan --plot surface.png
+    ddgjax sweep elastica --n 16 --param chord=0.2:0.9:50 --out chords.h5   (resumes if the file exists)
     ddgjax bench [--quick] [NAME ...]
     ddgjax --version                        (also `python -m ddgjax --version`)
 
@@ -12,7 +13,7 @@ input: a `DDGError` (also a malformed argument, a mesh file that cannot be read,
 that cannot be written) is printed as one line `ddgjax: error: … (hint: …)`, without a traceback
 unless `--debug`.
 
-`solve` and `verify` keep XLA's compiled programs on disk (`ddgjax.compile_cache`): a second
+`solve`, `sweep` and `verify` keep XLA's compiled programs on disk (`ddgjax.compile_cache`): a second
 cold run loads them instead of compiling.  `DDGJAX_COMPILE_CACHE=DIR` moves the cache,
 `DDGJAX_COMPILE_CACHE=off` switches it off.
 """
@@ -270,6 +271,104 @@ def _solve(args) -> int:
     return SOLVERS[args.object](args)
 
 
+# --- sweep ------------------------------------------------------------------------------------
+
+
+def _grid_axis(text: str) -> tuple[str, "object"]:
+    """`NAME=START:STOP:COUNT` -> (NAME, COUNT values from START to STOP, both included)."""
+    import numpy as np
+
+    name, _, values = text.partition("=")
+    parts = values.split(":")
+    if not name or len(parts) != 3:
+        raise argparse.ArgumentTypeError(f"expected NAME=START:STOP:COUNT (e.g. chord=0.2:0.9:50), got {text!r}")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"START and STOP must be numbers, got {text!r}") from None
+    count = int(parts[2]) if parts[2].strip().isdigit() else 0
+    if count < 1:
+        raise argparse.ArgumentTypeError(f"COUNT must be a positive integer, got {text!r}")
+    return name, np.linspace(start, stop, count)
+
+
+def _elastica_chord(values):
+    """`--param chord=...`: the chord vector (c, 0, 0), a chord of length c along x."""
+    import numpy as np
+
+    return np.stack([values, np.zeros_like(values), np.zeros_like(values)], axis=1)
+
+
+SWEEP_PARAMETERS = {"elastica": {"chord": _elastica_chord}}
+"""The parameters `ddgjax sweep OBJECT --param` varies: name -> (member values -> the problem's
+parameter array (B, ...))."""
+
+
+def _sweep_grid(args) -> dict:
+    """The product of the `--param` axes, flattened in C order (the last axis fastest), as the
+    problem's parameter arrays."""
+    import numpy as np
+
+    known = SWEEP_PARAMETERS[args.object]
+    axes = {}
+    for name, values in args.param:
+        if name not in known:
+            raise InvalidInputError(f"unknown parameter {name!r} of {args.object} (have: {', '.join(sorted(known))})")
+        if name in axes:
+            raise InvalidInputError(f"--param {name} given twice")
+        axes[name] = values
+    mesh = np.meshgrid(*axes.values(), indexing="ij")
+    return {name: known[name](m.ravel()) for name, m in zip(axes, mesh)}
+
+
+def _sweep_template_elastica(args, grid):
+    """The clamped elastica at the first member with a feasible chord (its start is the sweep's
+    `x0`); the first member's if none is feasible (which raises `InfeasibleChordError`)."""
+    import numpy as np
+
+    from energies import elastica
+
+    chords = grid["chord"]
+    feasible = np.flatnonzero(np.linalg.norm(chords, axis=1) < args.length)
+    chord = chords[feasible[0] if feasible.size else 0]
+    return elastica.clamped(args.n, length=args.length, chord=chord, t_start=args.t_start, t_end=args.t_end,
+                            clamp=args.clamp)
+
+
+SWEEP_TEMPLATES = {"elastica": _sweep_template_elastica}
+
+
+def _writable_file(path) -> Path:
+    """`path` for a data file: its directory writable (`_writable_directory`), not a directory."""
+    path = Path(path)
+    _writable_directory(path.parent)
+    if path.is_dir():
+        raise OutputPathError(f"cannot write the file {path}: it is a directory")
+    return path
+
+
+def _sweep(args) -> int:
+    from . import sweep
+
+    grid = _sweep_grid(args)
+    out = _writable_file(args.out)
+    problem = SWEEP_TEMPLATES[args.object](args, grid)
+    before = sweep.summary(out) if out.exists() else {"done": 0, "failed": 0}
+    kept = before["done"] - (before["failed"] if args.retry_failed else 0)
+    start = time.perf_counter()
+    sweep.run(problem, grid, out, chunk=args.chunk, warm_start=None if args.warm_start == "none" else args.warm_start,
+              progress=not args.no_progress, retry_failed=args.retry_failed, **_solver_options(args))
+    seconds = time.perf_counter() - start
+    counts = sweep.summary(out)
+    solved = counts["members"] - kept
+    print(f"{counts['members']} members: {counts['converged']} converged, {counts['failed']} failed "
+          f"({solved} solved now, {kept} already done)")
+    rate = f"{solved / seconds:.3g} members/s" if solved else "nothing left to solve"
+    print(f"time          {seconds:.2f} s ({rate})")
+    print(f"file          {out}")
+    return 0
+
+
 # --- bench ------------------------------------------------------------------------------------
 
 
@@ -339,6 +438,27 @@ def build_parser() -> argparse.ArgumentParser:
     solve.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     solve.set_defaults(run=_solve)
 
+    sweep = commands.add_parser("sweep", help="solve one object over a grid of parameters into an HDF5 file (resumable)")
+    sweep.add_argument("object", choices=sorted(SWEEP_PARAMETERS))
+    sweep.add_argument("--param", type=_grid_axis, action="append", required=True, metavar="NAME=START:STOP:COUNT",
+                       help="a grid axis, COUNT values from START to STOP; several give their product "
+                            "(elastica: chord, the chord's length along x)")
+    sweep.add_argument("--out", required=True, metavar="FILE", help="the HDF5 file; an existing one of the same sweep is resumed")
+    sweep.add_argument("--n", type=int, default=100, help="number of edges (default: 100)")
+    sweep.add_argument("--length", type=float, default=1.0, help="length of the curve (default: 1)")
+    sweep.add_argument("--t-start", **_vector("tangent at the start", [0.0, 1.0, 0.0]))
+    sweep.add_argument("--t-end", **_vector("tangent at the end", [0.0, -1.0, 0.0]))
+    sweep.add_argument("--clamp", choices=["edge", "vertex"], default="edge", help="elastica: Def 3.2 (edge) or vertex tangents")
+    sweep.add_argument("--chunk", type=_positive_int, default=64, help="members per batched solve (default: 64)")
+    sweep.add_argument("--warm-start", choices=["previous", "none"], default="previous",
+                       help="previous: a chunk starts from the last converged member before it (default); none: all from x0")
+    sweep.add_argument("--retry-failed", action="store_true", help="solve the members recorded as failed again")
+    sweep.add_argument("--max-steps", type=int, help="Newton steps (default: the solver's)")
+    sweep.add_argument("--tol", type=float, help="tolerance on the residual (default: the solver's, 1e-10)")
+    sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
+    sweep.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    sweep.set_defaults(run=_sweep)
+
     bench = commands.add_parser("bench", help="run the benchmark scripts (benchmarks/*.py) and print their tables")
     bench.add_argument("names", nargs="*", help="only these benchmarks (file names without .py)")
     bench.add_argument("--quick", action="store_true", help="pass --quick to the scripts that accept it")
@@ -356,7 +476,7 @@ def main(argv: list[str] | None = None) -> int:
     args = None
     try:
         args = build_parser().parse_args(argv)
-        if args.command in ("solve", "verify"):  # not for `bench`, which measures compile times
+        if args.command in ("solve", "sweep", "verify"):  # not for `bench`, which measures compile times
             compile_cache.enable()
         return args.run(args)
     except (DDGError, OSError) as error:

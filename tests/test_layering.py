@@ -42,6 +42,7 @@ LAYER_OF_PREFIX = {
     "ddgjax.plot": OUTPUT,
     "ddgjax.verify": APPLICATION,
     "ddgjax.cli": APPLICATION,
+    "ddgjax.sweep": APPLICATION,
     "ddgjax.compile_cache": APPLICATION,
     "ddgjax.__main__": APPLICATION,
     "ddgjax": OUTPUT,  # the package facade: imports the language, geometry, smooth and output layers
