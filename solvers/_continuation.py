@@ -52,8 +52,6 @@ from typing import Callable, NamedTuple
 import jax
 import jax.numpy as jnp
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ddgjax.errors import ConvergenceError, InvalidInputError
 from ddgjax.problem import Problem, flatten_multipliers
@@ -219,6 +217,8 @@ class _Family:
     def system(self, y: np.ndarray):
         """`(F, F_w, F_p, residual)` at y = (w, p) as NumPy arrays, residual the scaled max-norm
         (NaN where the energy is not finite)."""
+        import scipy.sparse as sp
+
         z0, params, dz0, dparams, weights = self.at(float(y[-1]))
         F, K, F_p, energy = _system(self.spec, self.linear, z0, params, jnp.asarray(y[:-1]), dz0, dparams)
         F, K, F_p = np.asarray(F), np.asarray(K), np.asarray(F_p)
@@ -245,6 +245,9 @@ class _Family:
 def _bordered_solve(K, F_p, row, rhs) -> np.ndarray:
     """Solve `[[K, F_p], [row]] v = rhs`: LU (sparse for a sparse K), least squares where singular
     (a continuous symmetry that no fixed entry breaks)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
     if sp.issparse(K):
         border = [[K, sp.csc_matrix(F_p[:, None])], [sp.csc_matrix(row[None, :-1]), sp.csc_matrix(row[None, -1:])]]
         A = sp.bmat(border, format="csc")

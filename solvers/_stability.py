@@ -68,8 +68,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import scipy.linalg
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ddgjax._checks import check_finite, check_same_structure, is_concrete
 from ddgjax.errors import InvalidInputError, ShapeError
@@ -204,6 +202,8 @@ def _kkt_matrix(kkt_spec, linear, z, params, w):
 def _hessian_and_jacobian(problem, spec, z, w, method: str):
     """`(H, J)`: ∇²_u L (n, n) and Dg (m, n) on the free entries, dense arrays or scipy CSR
     matrices, from the KKT matrix `[[∇²L, −Jᵀ], [−J, 0]]` the solver assembles."""
+    import scipy.sparse as sp
+
     n = spec.n
     if method == "dense":
         K = np.asarray(_kkt_matrix(spec, DenseLU(), z, problem.params, w))
@@ -294,6 +294,8 @@ def _dense(H, J, G, k, scale, tol, zero_tol):
 
 def _bordered(A, C, shift: float = 0.0):
     """`[[A − shift·I, Cᵀ], [C, 0]]` as CSC."""
+    import scipy.sparse as sp
+
     m, n = C.shape
     top = A - shift * sp.identity(n) if shift else A
     return sp.bmat([[top, C.T], [C, sp.csr_matrix((m, m))]], format="csc") if m else sp.csc_matrix(top)
@@ -302,6 +304,9 @@ def _bordered(A, C, shift: float = 0.0):
 def _projector(J):
     """`project(V)`: the orthogonal projection of the columns of V onto ker J (a sparse LU of
     [[I, Jᵀ], [J, 0]])."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
     m, n = J.shape
     if m == 0:
         return lambda V: np.asarray(V).reshape(n, -1)
@@ -338,6 +343,8 @@ class _Inertia:
             self.solver.libmkl.MKL_Set_Num_Threads(PARDISO_THREADS)
 
     def count(self, shift: float) -> int:
+        import scipy.sparse as sp
+
         K = _bordered(self.A, self.C, shift).tocoo()
         keep = K.row <= K.col
         size = K.shape[0]
@@ -372,6 +379,8 @@ class _Spectrum:
         """Add k eigenpairs: those just above σ ("LA") or nearest σ ("LM"), from
         `T b = [I 0] [[H − σI, Cᵀ], [C, 0]]⁻¹ [b; 0]` (eigenvalues 1/(μ − σ) on ker C, 0 on the
         normal space) less Σ θ_i v_i v_iᵀ over the pairs found (Wielandt: they move to 0)."""
+        import scipy.sparse.linalg as spla
+
         k = min(k, self.room)
         if k <= 0:
             return
@@ -433,6 +442,8 @@ PROBE_STEPS = 300  # Lanczos steps looking for a negative eigenvalue far from 0 
 
 
 def _sparse(H, J, G, k, scale, tol, zero_tol):
+    import scipy.sparse as sp
+
     n = H.shape[0]
     project = _projector(J)
     S = _zero_modes(project, lambda V: project(H @ V), G, scale, zero_tol)
@@ -494,6 +505,8 @@ def _without_inertia(spectrum: _Spectrum, H, S, project, k: int, scale: float, t
 def _probe_lowest(H, S, project, scale: float) -> float | None:
     """The lowest eigenvalue of H on ker J ∩ S^⊥ if Lanczos (`PROBE_STEPS` steps, the normal
     space shifted up by 2·scale) converges to it, else None."""
+    import scipy.sparse.linalg as spla
+
     n = H.shape[0]
 
     def apply(v):
