@@ -12,8 +12,9 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", "pendulum_shooting", "catenoid",
         "intrinsic_delaunay", "narrow_minimal_surface"]
 # the rod's KKT system takes minutes to compile on 2 cores, the bubbles' three KKT systems ~20 s
-# (their physics is checked by `ddgjax verify`, ext_bubbles): run with `make test-all`
-SLOW = ["twisted_rod", "soap_bubble"]
+# (their physics is checked by `ddgjax verify`, ext_bubbles), the catenoid fold's continuation ~10 s
+# (ext_continuation), the Willmore energies ~7 s (ext_willmore): run with `make test-all`
+SLOW = ["twisted_rod", "soap_bubble", "catenoid_fold", "willmore_sphere"]
 
 
 def load(name: str):
@@ -47,6 +48,10 @@ SHOWN = {
     "twisted_rod.png": [("3d", 3, [])],
     "soap_bubble.png": [("3d", 0, ["Poly3DCollection"]), BAR],
     "liquid_bridges.png": [("rectilinear", 2, [])],
+    # area and neck radius against H: smooth catenoids, index 0, index 1, the fold, the smooth fold
+    "catenoid_fold.png": [("rectilinear", 5, [])] * 2,
+    "willmore_sphere.png": [("3d", 0, ["Poly3DCollection"]), BAR],
+    "willmore_convergence.png": [("rectilinear", 2, [])],  # |W − 4π| and the fitted slope
 }
 
 

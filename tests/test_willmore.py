@@ -19,6 +19,7 @@ import pytest
 import ddgjax as dg
 from ddgjax import mesh
 from ddgjax.errors import InvalidInputError, MeshError, OrientationError
+from ddgjax.verify.checks.ext_willmore import random_moebius
 from energies import willmore
 
 LEVELS = (1, 2, 3, 4)
@@ -59,17 +60,6 @@ def _perturbed_sphere(level: int, amplitude: float, seed: int):
     V, F = _sphere(level)
     rng = np.random.default_rng(seed)
     return V * (1.0 + amplitude * rng.uniform(-1, 1, size=(len(V), 1))), F
-
-
-def _mobius(V, rng):
-    """x ↦ s R ι(x) + t, ι the inversion in a sphere of radius ρ centred at a point c at distance
-    ≥ 2.5 from the origin (away from the meshes, which lie within radius ~1.3)."""
-    c = rng.normal(size=3)
-    c *= rng.uniform(2.5, 4.0) / np.linalg.norm(c)
-    rho = rng.uniform(0.5, 3.0)
-    X = c + rho**2 * (V - c) / np.sum((V - c) ** 2, axis=1, keepdims=True)
-    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    return rng.uniform(0.3, 3.0) * X @ Q.T + rng.normal(size=3)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -268,7 +258,7 @@ def test_conformal_energy_is_moebius_invariant_and_helfrich_is_not():
     _, beta = willmore.circle_angles(V, F)
     worst_beta, worst, least_h = 0.0, 0.0, np.inf
     for _ in range(5):
-        X = _mobius(V, rng)
+        X = random_moebius(V, rng)
         worst_beta = max(worst_beta, float(np.max(np.abs(willmore.circle_angles(X, F)[1] - beta))))
         worst = max(worst, abs(_energy(willmore.conformal(X, F)) - W))
         least_h = min(least_h, abs(_energy(willmore.helfrich(X, F)) - W_h))

@@ -60,9 +60,10 @@ def conformal_vanishes_inscribed(ctx, level, points):
     return max(abs(_energy(willmore.conformal(V, F))) for V, F in meshes)
 
 
-def _mobius(V, rng):
-    """Inversion in a sphere centred at distance 2.5–4 from the origin (the mesh lies within 1.3),
-    then a rotation, a scale and a translation."""
+def random_moebius(V, rng):
+    """x ↦ s R ι(x) + t: ι the inversion in a sphere of radius ρ ∈ [0.5, 3] centred at distance
+    2.5–4 from the origin (outside meshes within radius ~1.5), then a rotation R, a scale s and a
+    translation t, all drawn from `rng`."""
     c = rng.normal(size=3)
     c *= rng.uniform(2.5, 4.0) / np.linalg.norm(c)
     X = c + rng.uniform(0.5, 3.0) ** 2 * (V - c) / np.sum((V - c) ** 2, axis=1, keepdims=True)
@@ -81,7 +82,7 @@ def conformal_moebius_invariance(ctx, level, maps):
     W, W_h = _energy(willmore.conformal(V, F)), _energy(willmore.helfrich(V, F))
     worst, least_h = 0.0, np.inf
     for _ in range(maps):
-        X = _mobius(V, rng)
+        X = random_moebius(V, rng)
         worst = max(worst, abs(_energy(willmore.conformal(X, F)) - W) / W)
         least_h = min(least_h, abs(_energy(willmore.helfrich(X, F)) - W_h))
     return worst if W > 0 and least_h > 1e-2 else float("nan")
