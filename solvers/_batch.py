@@ -181,17 +181,31 @@ def solve_batch(
     - `method`, `linear_solver`, `tol`, `max_steps`: as in `solve`.
     - `throw`: raise `ConvergenceError` naming the first member that did not converge.
 
-    **Returns:** a `Solution` whose leaves have a leading batch axis (sharded over `devices`).
+    **Returns:** a `Solution` whose leaves have a leading batch axis (sharded over `devices`
+    of this process; gathered whole into every process when `devices` span several).
 
-    **Several hosts.**  On a cluster, start every process with
-    `jax.distributed.initialize(coordinator_address, num_processes, process_id)` (on Slurm or
-    Cloud TPU the arguments are found automatically) before any other JAX call; `jax.devices()`
-    then lists the devices of all hosts, and `solve_batch(problem, params_batch,
-    devices="all")` run identically in every process splits the batch over all of them.  Each
-    process must pass the same full `params_batch` (it is placed with `jax.device_put`, each
-    host keeping its own slice); gather the result where it is needed with
-    `jax.experimental.multihost_utils.process_allgather`.  `method="sparse"` runs on CPU
-    hosts only; GPU/TPU hosts use `"dense"` or `"krylov"`.
+    **Several processes** (one per host, or several on one host; tested with two local CPU
+    processes in `tests/test_multiprocess.py`).  Every process
+
+    1. calls `jax.distributed.initialize(coordinator_address="HOST0:PORT", num_processes=P,
+       process_id=RANK)` before any other JAX call (under Slurm's `srun`, one task per host,
+       a bare `jax.distributed.initialize()` reads all three from Slurm's environment);
+    2. builds the same `problem` and the same full `params_batch` (all B members, not its
+       slice: each process places its devices' slices from its own copy, unchecked, so
+       different batches give a wrong result, not an error);
+    3. calls `solve_batch(problem, params_batch, devices="all")` with the same options, in the
+       same order as the other processes (it compiles in each and ends in an all-gather, a
+       collective: a process that skips a call leaves the others waiting).
+
+    `jax.devices()` lists the devices of all processes; the batch (padded to a multiple of
+    their number) is split over them, each device solving its slice, and the result is
+    gathered (`multihost_utils.process_allgather`), so every process gets the full `Solution`
+    of all B members on its default device, fully addressable, and `throw` raises the same
+    `ConvergenceError` in every process.  On CPU hosts the gather uses JAX's CPU collectives
+    (`jax_cpu_collectives_implementation`, `"gloo"` by default in JAX 0.10).  With
+    `devices=None`, or devices of this process only, each process solves the whole batch on
+    its own, without communicating.  `method="sparse"` runs on CPU hosts only; GPU/TPU hosts
+    use `"dense"` or `"krylov"`.
 
     **Raises:** `ShapeError` (batch axes missing or unequal), `InvalidInputError` (bad
     `method` or `devices`), `ConvergenceError` when `throw` and a member did not converge.
@@ -207,11 +221,22 @@ def solve_batch(
     options = (method, float(tol), int(max_steps))
     compiled = COMPILED.get(structure_key(problem, args, options, devices), lambda: _compile(problem, args, options, devices))
     sol = compiled(*args)
+    if not sol.steps.is_fully_addressable:
+        sol = _gathered(sol)
     if sol.steps.shape[0] > size:  # the padding of `_placed`
         sol = jax.tree_util.tree_map(lambda a: a[:size], sol)
     if throw:
         _raise_if_not_converged(sol, tol)
     return sol
+
+
+def _gathered(sol: Solution) -> Solution:
+    """`sol`, sharded over the devices of several processes, gathered whole into this process
+    (an all-gather across processes: every process must call it) and placed on its default
+    device."""
+    from jax.experimental import multihost_utils
+
+    return jax.tree_util.tree_map(jnp.asarray, multihost_utils.process_allgather(sol, tiled=True))
 
 
 def _raise_if_not_converged(sol: Solution, tol: float) -> None:
