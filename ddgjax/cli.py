@@ -5,6 +5,7 @@
     ddgjax solve rod --n 60 --alpha 0.7 --chord 0.6 0 0 --twist 2.5 --plot rod.png
     ddgjax solve minimal-surface --mesh annulus --height 0.4 --method cotan --plot surface.png
     ddgjax sweep elastica --n 16 --param chord=0.2:0.9:50 --out chords.h5   (resumes if the file exists)
+    ddgjax sweep-plot chords.h5 [--out chords.png]
     ddgjax bench [--quick] [NAME ...]
     ddgjax --version                        (also `python -m ddgjax --version`)
 
@@ -369,6 +370,16 @@ def _sweep(args) -> int:
     return 0
 
 
+def _sweep_plot(args) -> int:
+    from .plot import sweep as plot_sweep
+
+    out = _writable_figure(args.out or Path(args.file).with_suffix(".png"))
+    data = plot_sweep.load(args.file)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    print("figure       ", plot_sweep.family(data, out=out))
+    return 0
+
+
 # --- bench ------------------------------------------------------------------------------------
 
 
@@ -458,6 +469,12 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     sweep.set_defaults(run=_sweep)
+
+    sweep_plot = commands.add_parser("sweep-plot", help="draw a stored sweep: energy, residual, steps and shapes")
+    sweep_plot.add_argument("file", metavar="FILE", help="the HDF5 file of `ddgjax sweep`")
+    sweep_plot.add_argument("--out", metavar="PNG", help="the figure (default: FILE with the suffix .png)")
+    sweep_plot.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+    sweep_plot.set_defaults(run=_sweep_plot)
 
     bench = commands.add_parser("bench", help="run the benchmark scripts (benchmarks/*.py) and print their tables")
     bench.add_argument("names", nargs="*", help="only these benchmarks (file names without .py)")

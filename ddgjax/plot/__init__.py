@@ -4,6 +4,7 @@
 - surface: `surface`, `face_values` (polyhedral surfaces coloured by curvature, Sec 5.2);
 - laplace: `harmonic_function`, `minimal_surface` (Sec 6);
 - intrinsic: `triangulation`, `before_after` (non-Delaunay edges highlighted, Sec 7);
+- sweep: `family` (a stored `ddgjax.sweep` file: energy, residual, steps, shapes);
 - `save_figure`: the one place that lays out, writes and closes a figure.
 
 Every drawing function returns the matplotlib Figure when `path` is None, and when `path` is
@@ -16,6 +17,7 @@ from . import intrinsic as intrinsic
 from . import lines as lines
 from . import laplace as laplace
 from . import surface as surface
+from . import sweep as sweep
 from ._figure import save_figure as save_figure
 from .lines import (
     animate_spin_chain as animate_spin_chain,
@@ -26,4 +28,4 @@ from .lines import (
 )
 
 __all__ = ["animate_spin_chain", "convergence", "curve", "curves", "save_figure", "spin_chain", "intrinsic", "laplace",
-           "lines", "surface"]
+           "lines", "surface", "sweep"]
