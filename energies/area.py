@@ -362,10 +362,13 @@ def cone_volume(P: Float[Array, "3 3"], share, params) -> Float[Array, "1"]:
 
 
 def _boundary_halfedges(F: np.ndarray) -> np.ndarray:
-    """(k, 2): the halfedges (a, b), as the faces of F run through them, without a twin (b, a)."""
-    he = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
-    n = int(F.max()) + 1
-    return he[~np.isin(he[:, 1] * n + he[:, 0], he[:, 0] * n + he[:, 1])]
+    """(k, 2): the halfedges (a, b), as the faces of F run through them, without a twin
+    (`glue_triangles`; `OrientationError` for an inconsistently oriented F)."""
+    from ddgjax.mesh.connectivity import glue_triangles
+
+    halfedges, _ = glue_triangles(np.asarray(F), int(np.max(F)) + 1)
+    h = np.flatnonzero(halfedges.twin < 0)
+    return np.stack([halfedges.vertex[h], halfedges.head[h]], axis=1)
 
 
 def cap_volume(V, F) -> float:

@@ -58,9 +58,10 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
-from ddgjax.errors import InvalidInputError, MeshError, OrientationError
+from ddgjax.errors import InvalidInputError, MeshError
 from ddgjax.laplace import check_nondegenerate, checked_triangle_mesh
 from ddgjax.mesh import boundary_vertices
+from ddgjax.mesh.connectivity import glue_triangles
 
 from .area import face_area, face_volume
 
@@ -85,22 +86,12 @@ def _closed(V, F) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _halfedges(F: np.ndarray):
-    """Tails, heads and opposite corners of the 3·nf halfedges (face-major), and the index of the
-    twin of each (a closed, consistently oriented surface)."""
-    tail, head, opp = F.reshape(-1), np.roll(F, -1, axis=1).reshape(-1), np.roll(F, -2, axis=1).reshape(-1)
-    nv = int(F.max()) + 1
-    key = tail * nv + head
-    twin_key = head * nv + tail
-    order = np.argsort(key)
-    pos = np.searchsorted(key[order], twin_key)
-    pos = np.minimum(pos, key.size - 1)
-    twin = order[pos]
-    bad = np.flatnonzero(key[twin] != twin_key)
-    if bad.size:
-        h = int(bad[0])
-        raise OrientationError(f"edge ({int(tail[h])}, {int(head[h])}) of face {h // 3} is traversed in the same "
-                               "direction by both of its faces: orient the surface consistently")
-    return tail, head, opp, twin
+    """Tails, heads and opposite corners of the 3·nf halfedges h = 3f + i, and the twin of each
+    (`dg.mesh.connectivity.glue_triangles`; a closed surface has no −1).
+
+    **Raises:** `OrientationError` naming an edge that two faces traverse alike."""
+    halfedges, _ = glue_triangles(F, int(F.max()) + 1)
+    return halfedges.vertex, halfedges.head, halfedges.vertex[halfedges.prev], halfedges.twin
 
 
 def edge_stencil(F) -> np.ndarray:
