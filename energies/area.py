@@ -41,7 +41,7 @@ from jaxtyping import Array, Float
 
 import ddgjax as dg
 from ddgjax import intrinsic
-from ddgjax.errors import ConvergenceError, DDGError, DegenerateFaceError, InvalidInputError
+from ddgjax.errors import ConvergenceError, DDGError, DegenerateFaceError, InvalidInputError, NonFiniteError
 from ddgjax.laplace import (
     check_nondegenerate,
     checked_triangle_mesh,
@@ -271,7 +271,7 @@ def _auto(V, F, boundary, tol, max_iter):
         steps = budget if round_ == FLIP_ROUNDS else min(NEWTON_ROUND, budget)
         try:
             sol = minimize(simplicial(V1, F, b), tol=tol, max_steps=steps, throw=False)
-        except DegenerateFaceError as error:
+        except (DegenerateFaceError, NonFiniteError) as error:  # a re-flip made a face flat in space
             raise _degenerate_error(V1, F, flips, "a triangle degenerated") from error
         V1, budget = np.asarray(sol.x), budget - int(sol.steps)
         history.append(np.asarray(sol.history) if round_ == 0 else np.asarray(sol.history)[1:])

@@ -217,3 +217,13 @@ def test_default_minimal_surface_neck_order_two():
         errors.append(abs(references.neck_radius(W) - references.catenoid_neck()))
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     assert np.all(np.abs(orders - 2.0) < 0.1)
+
+
+@pytest.mark.slow
+def test_default_minimal_surface_on_a_wavy_tall_dome_fails_with_a_convergence_error():
+    """A non-planar boundary (`tall_dome(wave=0.3)`) on which the minimisation lets a face become
+    flat in space after a Delaunay re-flip: `ConvergenceError` saying a triangle degenerated (the
+    documented failure), never the `NonFiniteError` of the inner solve blaming its start."""
+    V, F, b = dg.mesh.builtin.tall_dome(0, wave=0.3)
+    with pytest.raises(ConvergenceError, match="degenerated"):
+        area.minimal_surface(V, F, b)
