@@ -1,5 +1,5 @@
-"""Discrete isotropic elastic rods (Def 3.6, 3.7, Remark 3.16): a framed polygon declared as an
-energy of unit quaternion edge frames.
+"""Discrete elastic rods (Def 3.6, 3.7, Remark 3.16): a framed polygon declared as an energy of
+unit quaternion edge frames, isotropic by default, anisotropic with `bending=(b1, b2)`.
 
 Unknowns: one unit quaternion Φ_k per edge (n, 4); the edge tangent is `T_k = Φ_k i Φ_k⁻¹`
 (`quaternion.rotate(Φ_k, e1)`).  With edge length h = L/n the energy is
@@ -10,6 +10,21 @@ the discrete elastica's bending term (`elastica.bending_density`, → ½∫κ²)
 squared discrete twist angles θ_k of `Φ_k Φ_{k−1}⁻¹ = t_k b_k` (`frames.twist_angle`, θ_k/h → τ),
 so that the smooth limit is ½∫(κ² + ατ²) ds.  Constraints (named, as for the elastica):
 `"unit"`, |Φ_k|² − 1 = 0 for the free frames, and `"chord"`, `c − h Σ T_k = 0` (3,).
+
+**Anisotropic bending** (Remark 3.16, `bending=(b1, b2)`).  The smooth energy
+`½ ∫ (b1 κ1² + b2 κ2² + α τ²) ds` with `κ1 = <T', N>`, `κ2 = <T', B>` weighs the bending by
+the direction of the curvature vector in the material frame.  Discretely, with the vertex
+curvatures `(κ1, κ2)_k = (K3, −K2)` of the half-twisted frame (`frames.discrete_curvatures`),
+the bending term becomes
+
+    (2/h) w_k E_k,    w_k = (b1 κ1² + b2 κ2²) / (κ1² + κ2²),
+
+the isotropic E_k = log(1 + h²κ²/4) times the stiffness in the direction of K_k (evaluated as
+`(h²/4)(b1 κ1² + b2 κ2²) · log(1 + t)/t`, t = h²κ²/4, smooth at straight vertices).  So
+`bending=(β, β)` is β times the isotropic energy with twist stiffness α/β, and `(1, 1)` is the
+isotropic rod.  Lemma 3.12 needs isotropy: with b1 ≠ b2 the twist is not constant, the smooth
+rod satisfies `α τ' = (b1 − b2) κ1 κ2` (the axial Euler equation of the top with inertia
+`diag(α, b2, b1)`).
 
 **Clamps** (as for `elastica.clamped`).  `clamp="edge"`: the end frames Φ_0, Φ_{n−1} are fixed.
 They are the frames of the first and last *edge*, i.e. of the smooth rod at s = h/2 and
@@ -25,8 +40,8 @@ Thm 3.13 computed by shooting (`ddgjax.kirchhoff`).
 half the rod functional `E_a` of Sec 3.5 with `a = λ`: `load(solution)` returns the chord
 multipliers, the smooth load `a` of Thm 3.13 (i) in the limit.
 
-Since the bending term does not see a rotation of Φ_k about T_k, stationarity in that direction
-gives θ_k = θ_{k+1}: the discrete twist of a critical rod is constant (the analogue of
+Since the isotropic bending term does not see a rotation of Φ_k about T_k, stationarity in that
+direction gives θ_k = θ_{k+1}: the discrete twist of a critical rod is constant (the analogue of
 Lemma 3.12, τ' = 0), which the tests check.
 """
 
@@ -46,7 +61,9 @@ from .elastica import (
     bending_density, checked_chord, checked_length, clamp_ends, start_data, starting_array, unit_and_chord,
 )
 
-__all__ = ["clamped", "tangents", "twist_angles", "curve", "load", "ClampMismatchError"]
+__all__ = [
+    "clamped", "anisotropic_bending_density", "tangents", "twist_angles", "curve", "load", "ClampMismatchError",
+]
 
 
 class ClampMismatchError(InvalidInputError):
@@ -55,10 +72,35 @@ class ClampMismatchError(InvalidInputError):
 E1 = jnp.array([1.0, 0.0, 0.0])
 
 
+def _log1p_ratio(t):
+    """`log(1 + t)/t` for t ≥ 0, with its value 1 (and series) at t = 0 so that gradients stay finite."""
+    small = t < 1e-6
+    safe = jnp.where(small, 1.0, t)
+    return jnp.where(small, 1.0 - t / 2 + t * t / 3, jnp.log1p(safe) / safe)
+
+
+def anisotropic_bending_density(
+    Phi_prev: Float[Array, "4"], Phi_next: Float[Array, "4"], bending: Float[Array, "2"]
+) -> Float[Array, ""]:
+    """`w_k E_k = (b1 k1² + b2 k2²)/4 · log(1 + t)/t`, `t = (k1² + k2²)/4 = tan²(φ_k/2)`, with
+    `(k1, k2) = h (κ1, κ2)_k` the discrete curvatures of the pair of edge frames
+    (`frames.discrete_curvatures` with h = 1) and `bending = (b1, b2)` (Remark 3.16, module
+    docstring).  Equals `elastica.bending_density(T_{k−1}, T_k)` for `bending = (1, 1)`."""
+    k1, k2, _ = frames.discrete_curvatures(jnp.stack([Phi_prev, Phi_next]), 1.0)
+    k1, k2 = k1[0], k2[0]
+    return 0.25 * (bending[0] * k1**2 + bending[1] * k2**2) * _log1p_ratio(0.25 * (k1**2 + k2**2))
+
+
+def _bending_term(Phi2, p):
+    """`E_k`, or `w_k E_k` when the problem has anisotropic stiffnesses `p["bending"]`."""
+    if "bending" in p:
+        return anisotropic_bending_density(Phi2[0], Phi2[1], p["bending"])
+    return bending_density(qt.rotate(Phi2[0], E1), qt.rotate(Phi2[1], E1))
+
+
 def _vertex_energy(Phi2, p):
-    T_prev, T_next = qt.rotate(Phi2[0], E1), qt.rotate(Phi2[1], E1)
     theta = frames.twist_angle(Phi2[0], Phi2[1])
-    return (2.0 / p["h"]) * bending_density(T_prev, T_next) + (p["alpha"] / (2.0 * p["h"])) * theta**2
+    return (2.0 / p["h"]) * _bending_term(Phi2, p) + (p["alpha"] / (2.0 * p["h"])) * theta**2
 
 
 def _reflected(Phi, q):
@@ -128,10 +170,31 @@ def _check_stiffness(alpha) -> None:
         )
 
 
+def _checked_bending(bending) -> Float[Array, "2"]:
+    """The stiffnesses (b1, b2) as a traceable (2,) array: `ShapeError` unless of shape (2,),
+    `NonFiniteError` for NaN or inf, `InvalidInputError` unless positive (values when concrete)."""
+    bending = jnp.asarray(bending, dtype=float)
+    checked_shape(bending, (2,), "bending")
+    check_finite(bending, "bending")
+    _check_bending(bending)
+    return bending
+
+
+@when_concrete
+def _check_bending(bending) -> None:
+    """Raise `InvalidInputError` unless both bending stiffnesses are positive."""
+    if not np.all(bending > 0):
+        raise InvalidInputError(
+            f"the bending stiffnesses (b1, b2) of κ1 = <T', N> and κ2 = <T', B> must be positive, "
+            f"got {np.asarray(bending).tolist()}"
+        )
+
+
 def clamped(
     n: int,
     *,
     alpha: float,
+    bending=None,
     length: float = 1.0,
     chord,
     frame_start,
@@ -143,19 +206,24 @@ def clamped(
 ) -> dg.Problem:
     """A clamped discrete elastic rod: n unit quaternion edge frames (n, 4), twist stiffness α.
 
+    `bending` (optional): the stiffnesses `(b1, b2)` of κ1 = <T', N> and κ2 = <T', B>, an
+    anisotropic rod (Remark 3.16, module docstring); None, the default, is the isotropic rod
+    (b1 = b2 = 1).
+
     `frame_start`, `frame_end`: unit quaternions [4], the clamped frames (their tangents are
     `rotate(frame, e1)`), of the end edges (`clamp="edge"`) or the end vertices
     (`clamp="vertex"`, second order; module docstring).  `t_start`, `t_end` (optional): the end
     tangents, checked against the frames.  Constraints `{"unit": (m,), "chord": (3,)}` with
     one unit entry per free frame (m = n − 2 for `clamp="edge"`, n for `"vertex"`).
 
-    Differentiable in `alpha`, `length`, `chord` and the end frames (traced values in `params`
-    and the clamped rows of `x0`, as for `elastica.clamped`).
+    Differentiable in `alpha`, `bending`, `length`, `chord` and the end frames (traced values in
+    `params` and the clamped rows of `x0`, as for `elastica.clamped`).
 
     **Raises:** `InfeasibleChordError` (|chord| ≥ length), `InvalidInputError` (α ≤ 0 or not
-    finite, n < 3, a length that is not finite and positive, non-unit frames, unknown clamp),
-    `NonFiniteError` (NaN in a frame or the chord), `ClampMismatchError` (a frame's tangent is
-    not the given end tangent), `ShapeError`.  Values are checked when concrete.
+    finite, a bending stiffness ≤ 0, n < 3, a length that is not finite and positive, non-unit
+    frames, unknown clamp), `NonFiniteError` (NaN in a frame or the chord, NaN or inf in
+    `bending`), `ClampMismatchError` (a frame's tangent is not the given end tangent),
+    `ShapeError` (also for `bending` not of shape (2,)).  Values are checked when concrete.
     """
     n = checked_count(n, 3, "n, the number of edges of a clamped rod,")
     if clamp not in ("edge", "vertex"):
@@ -163,6 +231,7 @@ def clamped(
     alpha = jnp.asarray(alpha, dtype=float)
     checked_shape(alpha, (), "alpha")
     _check_stiffness(alpha)
+    stiffness = {} if bending is None else {"bending": _checked_bending(bending)}
     length = checked_length(length)
     chord = checked_chord(chord, length)
     q0, q1 = checked_frame(frame_start, "frame_start"), checked_frame(frame_end, "frame_end")
@@ -178,7 +247,7 @@ def clamped(
         energy = energy + dg.local_sum(_ghost_vertex_energy, np.array([[0], [n - 1]]), data=np.array([0, 1]))
         fixed, free_edges = np.zeros((n, 4), bool), edges
     constraints = unit_and_chord(free_edges, n, _unit, _chord)
-    params = {"h": length / n, "alpha": alpha, "chord": chord, "frame_start": q0, "frame_end": q1}
+    params = {"h": length / n, "alpha": alpha, **stiffness, "chord": chord, "frame_start": q0, "frame_end": q1}
     return dg.Problem(
         energy, Phi0, constraints=constraints, params=params, fixed=fixed, name=f"clamped rod (n={n}, clamp={clamp})"
     )

@@ -16,6 +16,9 @@ of (3.10)), γ' = T = Φ i Φ⁻¹ is integrated alongside with diffrax (8th-ord
 tolerance 1e-13), and the shooting equations are solved by optimistix's Levenberg–Marquardt
 method with the Jacobian by forward-mode differentiation through the integrator.
 
+`jet` evaluates γ, T, T', T'' and ω, ω' along a rod (by autodiff of the top's vector field), the
+ingredients of Thm 3.13 (i)–(iii).
+
 This is the *independent* smooth reference for the discrete rods of `energies.rod`: nothing
 here uses the discrete energy; the discrete solution only provides a starting guess (which
 also selects the branch when the clamped problem has several solutions).
@@ -36,11 +39,11 @@ from jaxtyping import Array, Float
 from .. import quaternion as qt
 from ..curves import from_tangents
 from ..errors import ConvergenceError, InvalidInputError
-from ..frames import edge_frame_split
+from ..frames import angular_velocity, edge_frame_split
 from .top import TopState, equations_of_motion
 
 __all__ = [
-    "SmoothRod", "shoot", "clamped_rod", "from_discrete", "discrete_errors", "sample", "torsion",
+    "SmoothRod", "RodJet", "shoot", "clamped_rod", "from_discrete", "discrete_errors", "sample", "jet", "torsion",
     "discrete_top_residual",
 ]
 
@@ -174,6 +177,49 @@ def sample(rod: SmoothRod, s) -> tuple[Float[Array, "m 4"], Float[Array, "m 3"]]
     Phi, _M, gamma = _sample(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length),
                              jnp.asarray(s, dtype=float))
     return Phi, gamma
+
+
+class RodJet(NamedTuple):
+    """The centreline γ, the tangent T = γ' with its derivatives T', T'' and the spatial angular
+    velocity ω = 2Φ'Φ⁻¹ with ω' of a smooth rod at m arc lengths (each (m, 3))."""
+
+    gamma: Float[Array, "m 3"]
+    T: Float[Array, "m 3"]
+    dT: Float[Array, "m 3"]
+    ddT: Float[Array, "m 3"]
+    omega: Float[Array, "m 3"]
+    domega: Float[Array, "m 3"]
+
+
+def _tangent_and_angular_velocity(state: TopState, alpha, a):
+    """`(T, ω, T')` at a state of the top: `T = Φ i Φ⁻¹`, `ω = 2Φ'Φ⁻¹`, `T' = ω × T` (3.7)."""
+    omega = angular_velocity(state.Phi, equations_of_motion(state, alpha, a).Phi)
+    T = qt.rotate(state.Phi, E1)
+    return T, omega, jnp.cross(omega, T)
+
+
+@jax.jit
+def _jet(Phi, M, alpha, a):
+    def at(Phi, M):
+        state = TopState(Phi / jnp.linalg.norm(Phi), M)
+        velocity = equations_of_motion(state, alpha, a)
+        (T, omega, dT), (_, domega, ddT) = jax.jvp(
+            lambda y: _tangent_and_angular_velocity(y, alpha, a), (state,), (velocity,)
+        )
+        return T, dT, ddT, omega, domega
+
+    return jax.vmap(at)(Phi, M)
+
+
+def jet(rod: SmoothRod, s) -> RodJet:
+    """γ, T, T', T'', ω, ω' of the smooth rod at the arc lengths s (m,), from its top motion:
+    `(T, ω, T' = ω × T)` as functions of the state (Φ, M), and their derivatives along the
+    top's vector field by forward-mode autodiff (nothing typed in by hand).  Φ is normalised
+    first: the integrator leaves H_1 by its tolerance, which the polynomial extension of the
+    potential would turn into an O(|a| · tolerance) error of ω'."""
+    Phi, M, gamma = _sample(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length),
+                            jnp.asarray(s, dtype=float))
+    return RodJet(gamma, *_jet(Phi, M, jnp.asarray(rod.alpha), jnp.asarray(rod.a, dtype=float)))
 
 
 def torsion(rod: SmoothRod) -> float:
