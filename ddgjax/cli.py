@@ -4,7 +4,8 @@
     ddgjax solve elastica --n 100 --chord 0.5 0 0 --t-start 0 1 0 --t-end 0 -1 0 --plot out.png
     ddgjax solve rod --n 60 --alpha 0.7 --chord 0.6 0 0 --twist 2.5 --plot rod.png
     ddgjax solve minimal-surface --mesh annulus --height 0.4 --method cotan --plot surface.png
-    ddgjax sweep elastica --n 16 --param chord=0.2:0.9:50 --out chords.h5   (resumes if the file exists)
+    ddgjax sweep elastica --n 16 --param chord=0.2:0.9:50 --out chords.h5   (resumes if the file exists;
+                                                                            --processes K: K local processes)
     ddgjax sweep-plot chords.h5 [--out chords.png]
     ddgjax bench [--quick] [NAME ...]
     ddgjax --version                        (also `python -m ddgjax --version`)
@@ -206,16 +207,24 @@ def _rotation_taking_e1_to(t):
     return qt.from_axis_angle(axis / np.linalg.norm(axis), float(np.arccos(np.clip(t[0], -1.0, 1.0))))
 
 
+def _rod_end_frames(args):
+    """The rod's clamped end frames: the smallest rotations taking e1 to `--t-start`, `--t-end`,
+    the end one turned by `--twist` about its tangent."""
+    import numpy as np
+
+    from . import quaternion as qt
+
+    start, end = _rotation_taking_e1_to(args.t_start), _rotation_taking_e1_to(args.t_end)
+    return start, qt.mul(qt.from_axis_angle(qt.rotate(end, np.array([1.0, 0.0, 0.0])), args.twist), end)
+
+
 def _solve_rod(args) -> int:
     import numpy as np
 
     from energies import rod
     from solvers import solve
 
-    from . import quaternion as qt
-
-    start, end = _rotation_taking_e1_to(args.t_start), _rotation_taking_e1_to(args.t_end)
-    end = qt.mul(qt.from_axis_angle(qt.rotate(end, np.array([1.0, 0.0, 0.0])), args.twist), end)  # twist about T_end
+    start, end = _rod_end_frames(args)
     problem = rod.clamped(args.n, alpha=args.alpha, length=args.length, chord=args.chord, frame_start=start, frame_end=end)
     sol = solve(problem, **_solver_options(args))
     theta = np.asarray(rod.twist_angles(sol.x))
@@ -300,7 +309,12 @@ def _elastica_chord(values):
     return np.stack([values, np.zeros_like(values), np.zeros_like(values)], axis=1)
 
 
-SWEEP_PARAMETERS = {"elastica": {"chord": _elastica_chord}}
+def _scalar(values):
+    """`--param NAME=...` of a scalar parameter: the values themselves (B,)."""
+    return values
+
+
+SWEEP_PARAMETERS = {"elastica": {"chord": _elastica_chord}, "rod": {"chord": _elastica_chord, "alpha": _scalar}}
 """The parameters `ddgjax sweep OBJECT --param` varies: name -> (member values -> the problem's
 parameter array (B, ...))."""
 
@@ -325,18 +339,34 @@ def _sweep_grid(args) -> dict:
 def _sweep_template_elastica(args, grid):
     """The clamped elastica at the first member with a feasible chord (its start is the sweep's
     `x0`); the first member's if none is feasible (which raises `InfeasibleChordError`)."""
-    import numpy as np
-
     from energies import elastica
 
-    chords = grid["chord"]
+    return elastica.clamped(args.n, length=args.length, chord=_first_feasible_chord(args, grid), t_start=args.t_start,
+                            t_end=args.t_end, clamp=args.clamp)
+
+
+def _first_feasible_chord(args, grid):
+    """The chord of the first member shorter than the length (the first member's if none is: it
+    raises `InfeasibleChordError`); `--chord`'s (c, 0, 0) when the chord is not swept."""
+    import numpy as np
+
+    chords = grid.get("chord", np.array([[args.chord, 0.0, 0.0]]))
     feasible = np.flatnonzero(np.linalg.norm(chords, axis=1) < args.length)
-    chord = chords[feasible[0] if feasible.size else 0]
-    return elastica.clamped(args.n, length=args.length, chord=chord, t_start=args.t_start, t_end=args.t_end,
-                            clamp=args.clamp)
+    return chords[feasible[0] if feasible.size else 0]
 
 
-SWEEP_TEMPLATES = {"elastica": _sweep_template_elastica}
+def _sweep_template_rod(args, grid):
+    """The clamped rod (`--t-start`, `--t-end`, `--twist`, `--alpha`) at the first feasible chord
+    and the first α of the grid: the sweep's `x0`."""
+    from energies import rod
+
+    start, end = _rod_end_frames(args)
+    alpha = float(grid["alpha"][0]) if "alpha" in grid else args.alpha
+    return rod.clamped(args.n, alpha=alpha, length=args.length, chord=_first_feasible_chord(args, grid),
+                       frame_start=start, frame_end=end)
+
+
+SWEEP_TEMPLATES = {"elastica": _sweep_template_elastica, "rod": _sweep_template_rod}
 
 
 def _writable_file(path) -> Path:
@@ -348,26 +378,86 @@ def _writable_file(path) -> Path:
     return path
 
 
-def _sweep(args) -> int:
-    from . import sweep
+SWEEP_PROCESS = "DDGJAX_SWEEP_PROCESS"
+"""Set by `ddgjax sweep --processes K` in the K processes it starts: `ID:K:HOST:PORT`."""
 
+
+def _sweep(args) -> int:
     grid = _sweep_grid(args)
     out = _writable_file(args.out)
+    if args.processes > 1 and SWEEP_PROCESS not in os.environ:
+        return _launch_sweep_processes(args)
+    process = _join_sweep_processes(args)
+    from . import sweep
+
     problem = SWEEP_TEMPLATES[args.object](args, grid)
-    before = sweep.summary(out) if out.exists() else {"done": 0, "failed": 0}
+    before = sweep.summary(out) if out.exists() and process == 0 else {"done": 0, "failed": 0}
     kept = before["done"] - (before["failed"] if args.retry_failed else 0)
     start = time.perf_counter()
     sweep.run(problem, grid, out, chunk=args.chunk, warm_start=None if args.warm_start == "none" else args.warm_start,
-              progress=not args.no_progress, retry_failed=args.retry_failed, **_solver_options(args))
+              progress=not args.no_progress, retry_failed=args.retry_failed, processes=args.processes,
+              **_solver_options(args))
     seconds = time.perf_counter() - start
+    if process > 0:  # process 0 reports (and alone touches the file)
+        return 0
     counts = sweep.summary(out)
     solved = counts["members"] - kept
     print(f"{counts['members']} members: {counts['converged']} converged, {counts['failed']} failed "
-          f"({solved} solved now, {kept} already done)")
+          f"({solved} solved now, {kept} already done)" + (f" on {args.processes} processes" if args.processes > 1 else ""))
     rate = f"{solved / seconds:.3g} members/s" if solved else "nothing left to solve"
     print(f"time          {seconds:.2f} s ({rate})")
     print(f"file          {out}")
     return 0
+
+
+def _join_sweep_processes(args) -> int:
+    """In a process started by `_launch_sweep_processes`: join the others through
+    `jax.distributed.initialize` (before any JAX computation); its process index (0 otherwise)."""
+    if SWEEP_PROCESS not in os.environ:
+        return 0
+    process, count, host, port = os.environ[SWEEP_PROCESS].split(":")
+    import jax
+
+    jax.distributed.initialize(coordinator_address=f"{host}:{port}", num_processes=int(count),
+                               process_id=int(process), initialization_timeout=120)
+    return int(process)
+
+
+def _launch_sweep_processes(args) -> int:
+    """`ddgjax sweep ... --processes K`: the same command in K local processes joined by
+    `jax.distributed` (process 0 coordinates on a free localhost port, shows the progress and
+    writes the file; the others' output goes to a log kept on failure).  When one fails the
+    others are stopped; the exit code is the first failure's."""
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("localhost", 0))
+        port = probe.getsockname()[1]
+    procs, logs = [], []
+    for k in range(args.processes):
+        env = dict(os.environ, **{SWEEP_PROCESS: f"{k}:{args.processes}:localhost:{port}"})
+        log = None if k == 0 else tempfile.TemporaryFile(mode="w+")
+        logs.append(log)
+        procs.append(subprocess.Popen([sys.executable, "-m", "ddgjax", *args.argv], env=env,
+                                      stdout=log, stderr=subprocess.STDOUT if log else None))
+    try:
+        while None in (codes := [p.poll() for p in procs]) and not any(codes):
+            time.sleep(0.1)
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.terminate()
+            p.wait()
+    failed = next((k for k, p in enumerate(procs) if p.returncode), None)
+    if failed is not None and failed > 0:
+        logs[failed].seek(0)
+        lines = logs[failed].read().strip().splitlines() or ["(no output)"]
+        print(f"ddgjax: error: sweep process {failed} of {args.processes} failed (exit {procs[failed].returncode}): "
+              f"{lines[-1]}", file=sys.stderr)
+    for log in logs:
+        if log is not None:
+            log.close()
+    return 0 if failed is None else procs[failed].returncode
 
 
 def _sweep_plot(args) -> int:
@@ -460,12 +550,17 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--t-start", **_vector("tangent at the start", [0.0, 1.0, 0.0]))
     sweep.add_argument("--t-end", **_vector("tangent at the end", [0.0, -1.0, 0.0]))
     sweep.add_argument("--clamp", choices=["edge", "vertex"], default="edge", help="elastica: Def 3.2 (edge) or vertex tangents")
+    sweep.add_argument("--chord", type=float, default=0.5, help="the chord (c, 0, 0) when it is not swept (default: 0.5)")
+    sweep.add_argument("--alpha", type=float, default=0.7, help="rod: twist stiffness when it is not swept (default: 0.7)")
+    sweep.add_argument("--twist", type=float, default=0.0, help="rod: extra twist of the end frame in radians")
     sweep.add_argument("--chunk", type=_positive_int, default=64, help="members per batched solve (default: 64)")
     sweep.add_argument("--warm-start", choices=["previous", "none"], default="previous",
                        help="previous: a chunk starts from the last converged member before it (default); none: all from x0")
     sweep.add_argument("--retry-failed", action="store_true", help="solve the members recorded as failed again")
     sweep.add_argument("--max-steps", type=int, help="Newton steps (default: the solver's)")
     sweep.add_argument("--tol", type=float, help="tolerance on the residual (default: the solver's, 1e-10)")
+    sweep.add_argument("--processes", type=_positive_int, default=1, metavar="K",
+                       help="run the sweep in K local processes joined by jax.distributed (default: 1)")
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS)
     sweep.set_defaults(run=_sweep)
@@ -493,6 +588,7 @@ def main(argv: list[str] | None = None) -> int:
     args = None
     try:
         args = build_parser().parse_args(argv)
+        args.argv = list(sys.argv[1:] if argv is None else argv)
         if args.command in ("solve", "sweep", "verify"):  # not for `bench`, which measures compile times
             compile_cache.enable()
         return args.run(args)

@@ -42,11 +42,16 @@ it).  A run killed between chunks loses only
 the chunk in flight; HDF5 is not journaled, so a kill in the middle of a write (milliseconds per
 chunk) can leave the file unreadable: delete it and start again.
 
-**Processes.**  One process (`processes=None` or 1).  Several devices of one process are used
-through `devices=` (passed to `solve_batch`, which shards each chunk over them); several hosts
-through `solve_batch`'s multi-host sharding (`jax.distributed.initialize` in every process, see
-`solvers.solve_batch`), which this module does not drive: `processes > 1` raises
-`InvalidInputError`.
+**Processes.**  In one process (`processes=None` or 1) several devices are used through
+`devices=` (passed to `solve_batch`, which shards each chunk over them).  Several processes (one
+per host, or several on one machine) run the sweep SPMD on JAX's own multi-process runtime:
+every process calls `jax.distributed.initialize(...)` and then `run` with the same arguments;
+each chunk is one `solve_batch` over the devices of all processes (`devices="all"` by default
+then), which hands every process the whole chunk; process 0 alone opens and writes the file,
+and tells the others which members are pending and each chunk's warm start
+(`multihost_utils.broadcast_one_to_all`), so the file is the same as a one-process run's.  A
+failure of process 0 to open the file is raised in every process.  `processes=K` checks that
+JAX runs K processes.  `ddgjax sweep ... --processes K` starts K local processes so joined.
 
 **File layout** (`read` returns the same names):
 
@@ -414,19 +419,24 @@ def run(
     - `chunk`: members per `solve_batch` call (at most B).
     - `warm_start`: `"previous"` or `None` (module docstring).
     - `progress`: a rich progress bar with members per second on stderr.
-    - `processes`: `None` or 1 (module docstring, "Processes"); `devices`: `solve_batch`'s.
+    - `processes`: `None` (as many as JAX runs, `jax.process_count()`) or that number (module
+      docstring, "Processes"); `devices`: `solve_batch`'s (default: one device, or every
+      process's devices, `"all"`, when several processes run).
     - `retry_failed`: on a rerun, solve the recorded failures again too.
     - `tol`, `max_steps`, `method`: as in `solve` (part of the fingerprint).
 
     **Returns:** the path of the file.
 
-    **Raises:** `InvalidInputError` for a malformed grid, a bad option, `processes > 1`, a file
+    **Raises:** `InvalidInputError` for a malformed grid, a bad option, `processes` other than
+    `jax.process_count()`, a file
     that is not a sweep file or holds another sweep (problem, x0, parameters, grid or options
     differ), or a path that cannot be written.  A member's failure is recorded, never raised.
     """
-    if processes not in (None, 1):
-        raise InvalidInputError(f"processes={processes!r}: a sweep runs in one process; several devices go through "
-                                "devices=, several hosts through solve_batch's sharding (see ddgjax.sweep)")
+    count = jax.process_count()
+    if processes is not None and (isinstance(processes, bool) or processes != count):
+        raise InvalidInputError(
+            f"processes={processes!r}, but JAX runs {count} process(es): start each process with "
+            "jax.distributed.initialize(...) and call run in every one (or `ddgjax sweep --processes K`)")
     if warm_start not in WARM_STARTS:
         raise InvalidInputError(f"warm_start must be one of {WARM_STARTS}, got {warm_start!r}")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
@@ -438,20 +448,67 @@ def run(
     chunk = min(int(chunk), size)
     options = {"tol": float(tol), "max_steps": int(max_steps), "method": method}
     fingerprint = _fingerprint(problem, grid, {**options, "warm_start": warm_start})
-    with _open(out, problem, grid, size, fingerprint, {**options, "warm_start": warm_start, "chunk": chunk,
-                                                       "problem": problem.name}) as f:
-        pending = _pending(f, retry_failed)
-        bar = _Progress(progress, size, size - len(pending), "sweep")
+    attrs = {**options, "warm_start": warm_start, "chunk": chunk, "problem": problem.name}
+    lead = jax.process_index() == 0
+    if count > 1 and devices is None:
+        devices = "all"
+    f = _open_on_lead(out, problem, grid, size, fingerprint, attrs)
+    try:
+        pending = _pending_on_lead(f, size, retry_failed)
+        bar = _Progress(progress and lead, size, size - len(pending), "sweep")
         try:
             for start in range(0, len(pending), chunk):
                 index = pending[start:start + chunk]
-                template = problem if warm_start is None else problem.with_x0(_warm_x0(problem, f, int(index[0])))
+                template = problem if warm_start is None else problem.with_x0(_warm_x0_on_lead(problem, f, int(index[0])))
                 rows = _solve_chunk(template, grid, index, chunk, options, devices)
-                _write(f, index, rows)
+                if f is not None:
+                    _write(f, index, rows)
                 bar.advance(len(index), int(np.count_nonzero(~rows["converged"])))
         finally:
             bar.close()
+    finally:
+        if f is not None:
+            f.close()
     return Path(out)
+
+
+def _from_lead(value):
+    """`value` (a pytree of arrays, the same structure and shapes in every process) as process 0
+    has it; itself in a one-process run."""
+    if jax.process_count() == 1:
+        return value
+    from jax.experimental import multihost_utils
+
+    value = jax.tree_util.tree_map(np.asarray, value)
+    return jax.tree_util.tree_map(np.asarray, multihost_utils.broadcast_one_to_all(value))
+
+
+def _open_on_lead(out, problem, grid, size, fingerprint, attrs) -> h5py.File | None:
+    """The sweep file, opened by process 0 only (`None` in the others); an error opening it is
+    raised in every process."""
+    f, failure = None, None
+    if jax.process_index() == 0:
+        try:
+            f = _open(out, problem, grid, size, fingerprint, attrs)
+        except InvalidInputError as error:
+            failure = error
+    if bool(_from_lead(np.asarray(failure is not None))):
+        raise failure if failure is not None else InvalidInputError(f"process 0 could not open the sweep file {out}")
+    return f
+
+
+def _pending_on_lead(f: h5py.File | None, size: int, retry_failed: bool) -> np.ndarray:
+    """The members to solve, as process 0 reads them from the file."""
+    mask = np.zeros(size, dtype=bool)
+    if f is not None:
+        mask[_pending(f, retry_failed)] = True
+    return np.flatnonzero(_from_lead(mask))
+
+
+def _warm_x0_on_lead(problem: Problem, f: h5py.File | None, first: int):
+    """`_warm_x0` as process 0 reads it from the file."""
+    x0 = _warm_x0(problem, f, first) if f is not None else problem.x0
+    return _from_lead(x0)
 
 
 def summary(path) -> dict:

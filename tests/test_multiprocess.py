@@ -1,8 +1,9 @@
-"""Issue 21 (item 1): `solve_batch` over the devices of two JAX processes.
+"""`solve_batch` and `ddgjax sweep` over the devices of two JAX processes.
 
 Two local CPU processes, joined by `jax.distributed.initialize`, each pass the same full batch
 with `devices="all"`; the batch is split over the devices of both, and each process gets the
-whole result back.  Every member must equal the single-process `solve_batch` to 1e-12.
+whole result back.  Every member must equal the single-process `solve_batch` to 1e-12.  The
+sweep on two processes (`--processes 2`) writes the same file as on one.
 """
 
 import os
@@ -120,3 +121,30 @@ def test_two_process_solve_batch_equals_single_process(tmp_path, local_devices, 
             name = f"process {process}, Solution{jax.tree_util.keystr(path)}"
             assert got.shape == want.shape, name
             np.testing.assert_allclose(got.astype(float), np.asarray(want, float), rtol=0, atol=1e-12, err_msg=name)
+
+
+# --- ddgjax sweep --processes K ---------------------------------------------------------------
+
+
+def test_sweep_on_two_processes_writes_the_file_of_one_process(tmp_path):
+    """`ddgjax sweep ... --processes 2`: two local processes joined by jax.distributed solve each
+    chunk together (`solve_batch` over both processes' devices) and process 0 writes the file;
+    every stored result equals the one-process sweep's to 1e-12, the warm starts from the
+    previous chunk included."""
+    from ddgjax import cli, sweep
+
+    argv = ["sweep", "elastica", "--n", "8", "--param", "chord=0.3:0.7:6", "--chunk", "2", "--no-progress"]
+    assert cli.main([*argv, "--out", str(tmp_path / "one.h5")]) == 0
+    env = dict(os.environ, JAX_PLATFORMS="cpu", XLA_FLAGS=_xla_flags(1),
+               PYTHONPATH=os.pathsep.join(filter(None, [ROOT, os.environ.get("PYTHONPATH")])))
+    command = [sys.executable, "-m", "ddgjax", *argv, "--processes", "2", "--out", str(tmp_path / "two.h5")]
+    run = subprocess.run(command, cwd=ROOT, env=env, capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "6 converged, 0 failed (6 solved now, 0 already done) on 2 processes" in run.stdout
+    one, two = sweep.read(tmp_path / "one.h5"), sweep.read(tmp_path / "two.h5")
+    assert bool(np.all(one["converged"])) and bool(np.all(two["done"]))
+    for name in ("x", "energy", "residual", "multipliers"):
+        for a, b in zip(jax.tree_util.tree_leaves(one[name]), jax.tree_util.tree_leaves(two[name])):
+            np.testing.assert_allclose(b, a, rtol=0, atol=1e-12, err_msg=name)
+    np.testing.assert_array_equal(two["steps"], one["steps"])
+

@@ -13,7 +13,7 @@ import pytest
 
 from ddgjax import cli, sweep
 from ddgjax.errors import InvalidInputError
-from energies import elastica
+from energies import elastica, rod
 from solvers import solve, solve_batch
 
 N, MEMBERS, CHUNK, INFEASIBLE = 16, 20, 8, 7  # member 7, the last of the first chunk, cannot be solved
@@ -206,7 +206,8 @@ def test_another_grid_or_problem_on_the_same_file_is_refused(problem, grid, cold
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    (dict(processes=2), "one process"),
+    (dict(processes=2), "JAX runs 1 process"),
+    (dict(processes=True), "JAX runs 1 process"),
     (dict(warm_start="next"), "warm_start"),
     (dict(chunk=0), "chunk must be a positive integer"),
     (dict(params_grid={"chrod": np.zeros((2, 3))}), "no parameter 'chrod'"),
@@ -246,10 +247,28 @@ def test_cli_sweep_elastica(tmp_path, capsys):
     assert cli.main(argv) == 0 and "0 solved now" in capsys.readouterr().out  # resumed: nothing left
 
 
+def test_cli_sweep_rod_over_the_twist_stiffness(tmp_path, capsys):
+    """`ddgjax sweep rod --param alpha=...`: every member a critical rod with constant twist
+    (Lemma 3.12), the stiffness stored per member; the twist angle falls as α grows (the end
+    frames are fixed, so the same total twist costs αθ²: the rod bends to take some of it)."""
+    out = tmp_path / "alpha.h5"
+    argv = ["sweep", "rod", "--n", "8", "--param", "alpha=0.5:1.5:4", "--twist", "2.0", "--chord", "0.6",
+            "--chunk", "4", "--out", str(out), "--no-progress"]
+    assert cli.main(argv) == 0
+    assert "4 members: 4 converged, 0 failed" in capsys.readouterr().out
+    data = sweep.read(out)
+    assert np.allclose(data["alpha"], np.linspace(0.5, 1.5, 4)) and data["x"].shape == (4, 8, 4)
+    assert float(data["residual"].max()) <= 1e-10
+    theta = np.stack([np.asarray(rod.twist_angles(x)) for x in data["x"]])
+    assert float(np.ptp(theta, axis=1).max()) <= 1e-10
+    assert np.all(np.diff(np.abs(theta[:, 0])) < 0), theta[:, 0]
+
+
 @pytest.mark.parametrize("argv, message", [
     (["--param", "chord=0.2:0.8"], "sweep: argument --param: expected NAME=START:STOP:COUNT"),
     (["--param", "chord=0.2:0.8:0"], "COUNT must be a positive integer"),
     (["--param", "twist=0:1:3"], "unknown parameter 'twist' of elastica (have: chord)"),
+    (["--processes", "0"], "argument --processes"),
     (["--param", "chord=0:0.5:3", "--param", "chord=0:0.5:3"], "--param chord given twice"),
     (["--param", "chord=1.5:2:3"], "not shorter than the length"),
     (["--param", "chord=0.1:0.5:3", "--out", "/proc/x/s.h5"], "cannot write in the directory /proc/x"),
