@@ -8,9 +8,10 @@ clamped(64, chord=(c, 0, 0), t_start=(0, 1, 0), t_end=(0, −1, 0))`, c evenly s
   `warm_start="previous"` (continuation by chunks);
 - by `ddgjax.sweep.run(..., devices="all")` with two host devices
   (`XLA_FLAGS=--xla_force_host_platform_device_count=2`, set in a child process of this script,
-  which must set it before jax is imported): each chunk is sharded over both.  `processes > 1`
-  is refused by `sweep.run`; several hosts go through `solve_batch`'s `jax.distributed` path,
-  not measured here.
+  which must set it before jax is imported): each chunk is sharded over both;
+- by `sweep.run` on `--processes` K local processes joined by `jax.distributed` (one CPU device
+  each, child processes of this script; what `ddgjax sweep --processes K` starts): each chunk is
+  split over them, process 0 writes the file; its times and peak RSS, no per-chunk RSS column.
 
 Each row: the median of `--repeats` runs after a warm-up run (the warm-up compiles; "compile s"
 is its time minus the median; "≈0 (reused)" where `solve_batch` reuses the executable compiled
@@ -22,7 +23,7 @@ equal.  The default chord range starts at 0.3: from the default start, chords be
 at max_steps, and under `vmap` one such member keeps its whole chunk iterating to max_steps.
 
     python benchmarks/sweep.py [--quick] [--members 10000] [--chunk 128] [--repeats 3]
-                               [--loop-members M] [--devices 2] [--chord 0.3 0.8]
+                               [--loop-members M] [--devices 2] [--processes 2] [--chord 0.3 0.8]
 
 The machine may be shared: compare rows of one run only.
 """
@@ -142,6 +143,58 @@ def devices_row(args) -> dict | None:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+def processes_row(args) -> dict | None:
+    """The row of `sweep.run` on `--processes` K local processes joined by `jax.distributed`
+    (`process_worker`), each with one CPU device: process 0's times and file."""
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("localhost", 0))
+        port = probe.getsockname()[1]
+    env = dict(os.environ, XLA_FLAGS=f"{os.environ.get('XLA_FLAGS', '')} --xla_force_host_platform_device_count=1")
+    with tempfile.TemporaryDirectory() as scratch:
+        procs = [subprocess.Popen([sys.executable, __file__, "--process-worker", f"{k}:{args.processes}:{port}:{scratch}",
+                                   "--members", str(args.members), "--chunk", str(args.chunk), "--repeats",
+                                   str(args.repeats), "--chord", *map(str, args.chord)],
+                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                 for k in range(args.processes)]
+        outputs = [p.communicate() for p in procs]
+    if any(p.returncode for p in procs):
+        failed = next(k for k, p in enumerate(procs) if p.returncode)
+        progress(f"processes row failed in process {failed}: {outputs[failed][1].strip().splitlines()[-1:]}")
+        return None
+    return json.loads(outputs[0][0].strip().splitlines()[-1])
+
+
+def process_worker(args) -> None:
+    """One of the processes of `processes_row`: `sweep.run` of the family, `warm_start=None`, a
+    warm-up and `--repeats` timed runs into the shared scratch folder; process 0 prints the row."""
+    process, count, port, scratch = args.process_worker.split(":", 3)
+    import jax
+
+    jax.distributed.initialize(coordinator_address=f"localhost:{port}", num_processes=int(count),
+                               process_id=int(process), initialization_timeout=120)
+    from jax.experimental import multihost_utils
+
+    from ddgjax import sweep
+
+    problem, grid = family(args.members, tuple(args.chord))
+    times, before = [], None
+    for k in range(args.repeats + 1):
+        if k == 1:
+            before = memory()
+        start = time.perf_counter()
+        sweep.run(problem, grid, Path(scratch) / f"run{k}.h5", chunk=args.chunk, progress=False, warm_start=None)
+        times.append(time.perf_counter() - start)
+        multihost_utils.sync_global_devices(f"run {k}")  # process 0 has closed the file
+    if int(process) == 0:
+        data = sweep.read(Path(scratch) / f"run{args.repeats}.h5")
+        median = statistics.median(times[1:])
+        print(json.dumps({"members": len(data["done"]), "seconds": median, "compile": times[0] - median,
+                          "converged": int(data["converged"].sum()), "steps": float(data["steps"].mean()),
+                          "hwm": (before["VmHWM"], memory()["VmHWM"]), "rss": None}))
+
+
 def worker(args) -> None:
     import jax
 
@@ -156,9 +209,10 @@ def worker(args) -> None:
 def row_text(name: str, r: dict, base: dict) -> str:
     rate, anchor = r["members"] / r["seconds"], base["members"] / base["seconds"]
     rss = "—" if r["rss"] is None else " / ".join(f"{v:.0f}" for v in r["rss"])
+    hwm = "—" if r["hwm"] is None else f"{r['hwm'][0]:.0f} → {r['hwm'][1]:.0f}"
     compiled = f"{r['compile']:.1f}" if r["compile"] >= 0.5 else "≈0 (reused)"  # the executable of the row above
     return (f"| {name} | {r['members']} | {rate:.1f} | {rate / anchor:.2f}× | {compiled} | "
-            f"{r['converged']} | {r['steps']:.2f} | {r['hwm'][0]:.0f} → {r['hwm'][1]:.0f} | {rss} |")
+            f"{r['converged']} | {r['steps']:.2f} | {hwm} | {rss} |")
 
 
 def main(argv=None) -> int:
@@ -169,13 +223,18 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--loop-members", type=int, help="members of the loop (evenly spaced; default: all)")
     parser.add_argument("--devices", type=int, default=2, help="host devices of the sharded row (0: skip it)")
+    parser.add_argument("--processes", type=int, default=2, help="processes of the `ddgjax sweep --processes` row (0: skip it)")
     parser.add_argument("--chord", type=float, nargs=2, default=[0.3, 0.8], metavar=("START", "STOP"))
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--process-worker", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.quick:
         args.members = 500
     if args.worker:
         worker(args)
+        return 0
+    if args.process_worker:
+        process_worker(args)
         return 0
 
     import jax
@@ -194,6 +253,11 @@ def main(argv=None) -> int:
         row = devices_row(args)
         if row is not None:
             rows[f"sweep.run, devices='all' ({row.pop('devices')} host devices), warm_start=None"] = row
+    if args.processes > 1:
+        progress(f"sweep.run on {args.processes} processes (jax.distributed, child processes)")
+        row = processes_row(args)
+        if row is not None:
+            rows[f"sweep.run on {args.processes} processes × 1 device (jax.distributed), warm_start=None"] = row
 
     print(f"jax {jax.__version__} on {jax.devices()[0].platform}, {os.cpu_count()} cores, load "
           f"{os.getloadavg()[0]:.1f}; clamped elastica n = {N}, chord ({args.chord[0]}..{args.chord[1]}, 0, 0), "
