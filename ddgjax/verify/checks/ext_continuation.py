@@ -8,6 +8,13 @@ while c·cosh(H/c) = 1 has a root: up to H* = t*/cosh t* ≈ 0.6627 (t* tanh t* 
 where the stable catenoid (larger neck) and the unstable one (smaller neck) meet; beyond the
 fold the branch continues onto the unstable catenoid, whose neck keeps shrinking, with Morse index
 1 (Sec 3.1's second-order condition, `solvers.stability`).
+
+Euler buckling: the clamped elastica (Def 3.2, vertex clamps T = e1 at both ends, length 1)
+followed in its chord c·e1.  Every chord c < 1 forces the curve to bend (`clamped` refuses
+|c| ≥ L), so the straight rod is reached only as the limit c → 1 of the buckled branch, where
+the branch turns back (a fold in c: the pitchfork of the buckled shape and its mirror image,
+meeting at the straight rod) and the chord multiplier (the load of Thm 3.2's `T'' = cT + a`)
+is the critical load: 4π² for the smooth column of bending energy ½∫κ² clamped at both ends.
 """
 
 from __future__ import annotations
@@ -17,9 +24,11 @@ import functools
 import jax.numpy as jnp
 import numpy as np
 from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk
 
 import ddgjax as dg
 from ddgjax.verify import check
+from energies import elastica
 from energies.area import face_area
 from solvers import continuation
 
@@ -129,3 +138,121 @@ def scalar_fold(ctx, ds):
     fold = branch.folds[0]
     end = branch.x[-1, 0]
     return abs(fold.p - 1.0) + abs(float(fold.x[0])) + abs(end + 1.0) + abs(branch.index[-1] - 1)
+
+
+# --- Euler buckling: the clamped elastica followed in its chord ---------------------------------
+
+E1 = np.array([1.0, 0.0, 0.0])
+CHORD_START = 0.9  # the branch starts on the buckled elastica with chord 0.9·e1 (length L = 1)
+CHORD_BEYOND = 1.5  # a target beyond the longest chord |c| < L: the branch must turn back at c = L
+EULER_LOAD = 4.0 * np.pi**2  # clamped–clamped, bending energy ½∫κ² (B = 1), L = 1
+PINNED_LOAD = np.pi**2  # the pinned–pinned column's: the wrong constant here
+
+
+def discrete_euler_load(n: int, length: float = 1.0) -> float:
+    """λ_h = (2 sin(πh)/h)², h = L/n: the load at which the straight discrete elastica with
+    vertex clamps buckles.
+
+    Linearised about T_k = e1, with T_k = (cos θ_k, sin θ_k, 0): the energy `(2/h) Σ E_k` is
+    `(1/2h) θᵀQθ`, Q the Dirichlet Laplacian on the edge midpoints s_k = (k + ½)h (the ghost
+    edges of the vertex clamps give θ_{−1} = −θ_0, θ_n = −θ_{n−1}); the chord's e1 component
+    contributes `−(λh/2) |θ|²` to the Lagrangian and its transverse component requires Σ θ_k = 0.
+    The mode θ_k = sin(2πs_k) meets that constraint and has Qθ = 4 sin²(πh) θ, so the second
+    variation degenerates on it at λ h = 4 sin²(πh)/h (the lowest such load, as for the smooth
+    column, whose next constrained mode needs 8.18π²): λ_h = 4π²(1 − (πh)²/3 + O(h⁴)) → 4π²/L²,
+    Euler's critical load of the clamped–clamped column of bending stiffness 1.  (λ_h differs
+    from the two-term expansion by 3.6e-3 relative at n = 6, by O(h⁴) in general.)"""
+    h = length / n
+    return float((2.0 * np.sin(np.pi * h) / h) ** 2)
+
+
+def euler_load(chord: float, length: float = 1.0) -> float:
+    """The load a = (4K(m)/L)² of the clamped–clamped Euler elastica with T(0) = T(L) = e1 and
+    chord `chord`·e1 (Thm 3.2; the inflectional elastica over one period of its curvature, whose
+    chord over length is 2E(m)/K(m) − 1; `ddgjax.smooth.elastica`): (4K(m)/L)² → 4π²/L² as the
+    chord tends to L (m → 0)."""
+    m = brentq(lambda m: 2.0 * ellipe(m) / ellipk(m) - 1.0 - chord / length, 1e-14, 1.0 - 1e-12, xtol=1e-15)
+    return float((4.0 * ellipk(m) / length) ** 2)
+
+
+def buckling_family(n: int):
+    """`problem_of(c)`: `energies.elastica.clamped(n, chord=(c, 0, 0), t_start=e1, t_end=e1,
+    clamp="vertex")` for every c, one declaration (the chord enters through `params`)."""
+    base = elastica.clamped(n, chord=(CHORD_START, 0.0, 0.0), t_start=E1, t_end=E1, clamp="vertex")
+    return lambda c: base.with_params({**base.params, "chord": jnp.asarray(c) * jnp.asarray(E1)})
+
+
+@functools.cache
+def buckling_branch(n: int):
+    """The buckled clamped elastica followed from c = 0.9 towards c = 1.5: it straightens at a
+    fold at c = L = 1 and returns to c = 0.9 on its mirror image."""
+    return continuation(buckling_family(n), CHORD_START, CHORD_BEYOND, max_points=40, index=False)
+
+
+def mirror_defect(n: int) -> float:
+    """max_k |T_k(end) − R T_k(start)|, R = diag(1, −1, −1) the half-turn about e1: the branch
+    returns to c = 0.9 on the mirror image (in its plane) of the elastica it started from."""
+    branch = buckling_branch(n)
+    return float(np.max(np.abs(np.asarray(branch.x[-1]) - np.asarray(branch.x[0]) * np.array([1.0, -1.0, -1.0]))))
+
+
+def fold_load(n: int) -> tuple[float, float]:
+    """`(c_fold, λ_fold)`: the chord and the chord multiplier's e1 component at the branch's fold
+    (inf, inf unless the branch turns back once).
+
+    At the fold the rod is straight (to ~1e-7), where the constraints' gradients are dependent
+    (the chord's e1 row is a combination of the unit rows): the KKT conditions hold for every
+    load there, and λ_fold is fixed only by the branch through it, to ~1e-5 relative."""
+    branch = buckling_branch(n)
+    if len(branch.folds) != 1 or branch.stopped != "returned to p0":
+        return float("inf"), float("inf")
+    fold = branch.folds[0]
+    return fold.p, float(elastica.load(fold)[0])
+
+
+@check("Thm 3.2, Def 3.2", "the clamped discrete elastica (vertex clamps T = e1 at both ends) followed in its chord "
+       "c·e1 from c = 0.9 straightens at a fold at c = L = 1 and returns to c = 0.9 on the mirror image of its start; "
+       "the chord multiplier there is the discrete Euler load λ_h = (2 sin(πh)/h)² (the straight rod's second "
+       "variation degenerates on θ_k = sin(2π(k + ½)h)), λ_h → 4π²",
+       quantity="|c_fold − 1| + |λ_fold/λ_h − 1| + max_k |T_k(end) − R_π T_k(start)|", at_most=1e-3,
+       quick=dict(n=8), full=dict(n=32))
+def elastica_buckling_fold(ctx, n):
+    c, load = fold_load(n)
+    return abs(c - 1.0) + abs(load / discrete_euler_load(n) - 1.0) + mirror_defect(n)
+
+
+@check("Thm 3.2, Def 3.2", "negative control: the load at the fold is not the pinned–pinned column's π² but four "
+       "times it (|λ_fold/π² − 1| tends to 3)", quantity="|λ_fold/π² − 1|", at_least=2.5,
+       quick=dict(n=8), full=dict(n=32))
+def elastica_buckling_not_pinned(ctx, n):
+    return abs(fold_load(n)[1] / PINNED_LOAD - 1.0)
+
+
+@check("Thm 3.2, Def 3.2", "the buckling load converges to Euler's critical load 4π² of the clamped–clamped column "
+       "(bending energy ½∫κ², L = 1) at second order (n = 8, 12, 16, 24)",
+       quantity="fitted order of |λ_fold(n) − 4π²|", target=2.0, within=0.2, quick=dict(ns=(8, 12, 16, 24)),
+       full_only=True)
+def elastica_buckling_load_order(ctx, ns):
+    table = ctx.convergence(dg.limits.convergence(lambda n: abs(fold_load(n)[1] - EULER_LOAD), list(ns)),
+                            "elastica_buckling_load_order", title="Euler buckling: |λ_fold − 4π²| against n")
+    return float(table.fitted_order)
+
+
+def branch_load_error(n: int, chord_max: float = 0.99) -> float:
+    """max |λ(c) − a(c)| / a(c) over the points of the buckling branch with c ≤ `chord_max`:
+    the discrete load against the smooth Euler elastica's (`euler_load`)."""
+    branch = buckling_branch(n)
+    loads = np.asarray(branch.multipliers["chord"])[:, 0]
+    keep = branch.p <= chord_max
+    return float(max(abs(load / euler_load(c) - 1.0) for c, load in zip(branch.p[keep], loads[keep])))
+
+
+@check("Thm 3.2, Def 3.2", "along the buckled branch (0.9 ≤ c ≤ 0.99) the discrete load converges to the load "
+       "(4K(m))² of the smooth clamped–clamped Euler elastica with the same chord, 2E(m)/K(m) − 1 = c, at second "
+       "order (n = 8, 12, 16, 24)", quantity="fitted order of max_c |λ(c)/a(c) − 1|", target=2.0, within=0.2,
+       quick=dict(ns=(8, 12, 16, 24)), full_only=True)
+def elastica_buckled_load_order(ctx, ns):
+    table = ctx.convergence(dg.limits.convergence(branch_load_error, list(ns)), "elastica_buckled_load_order",
+                            title="buckled elastica: max |λ(c)/a(c) − 1| against n")
+    return float(table.fitted_order)
+
