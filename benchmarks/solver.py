@@ -31,7 +31,7 @@ import scipy.sparse
 import ddgjax as dg  # noqa: F401  (float64)
 from solvers import solve
 from solvers._kkt import KKT, spec_of
-from solvers._sparse import build_pattern, cell_blocks
+from solvers._sparse import build_pattern, index_arrays, kkt_values
 from solvers.problems import unit_chain
 
 
@@ -62,17 +62,9 @@ class ScipyChain:
         self.z0 = self.spec.layout.ravel(problem.x0)
         self.kkt = KKT(self.spec, self.z0, problem.params)
         n, m = self.spec.n, self.spec.m
-        p = self.pattern
-        src, tgt = np.asarray(p.source), np.asarray(p.target)
+        p, index = self.pattern, index_arrays(self.pattern)
         self.size = n + m
-
-        def blocks(w):
-            hess, jac = cell_blocks(p, self.kkt, w, False)
-            raw = jnp.concatenate([hess, -jac])
-            values = jnp.concatenate([raw[src], jnp.zeros(n + m)])
-            return jax.ops.segment_sum(values, tgt, num_segments=p.nnz)
-
-        self.blocks = jax.jit(blocks)
+        self.blocks = jax.jit(lambda w: kkt_values(p, index, self.kkt, w))  # the KKT matrix at `pattern.rows/cols`
         self.f = jax.jit(self.kkt.energy)
         self.grad = jax.jit(jax.grad(self.kkt.energy))
         self.g = jax.jit(self.kkt.g)
