@@ -42,6 +42,9 @@ class Solution(NamedTuple):
     - `converged`: `residual <= tol` and the energy finite at `x`.
     - `history`: residual after each step (`history[0]` at the start of Newton).
     - `status`: 0 converged, 1 max_steps reached, 2 stalled, 3 non-finite.
+    - `first_order_steps`: outer augmented-Lagrangian L-BFGS steps run before Newton
+      (`warm_start="lbfgs"`, or the retry of `warm_start="auto"`: a positive count there says
+      that the first Newton run stopped and this solution is the retry's; 0 otherwise).
     """
 
     x: object
@@ -52,6 +55,7 @@ class Solution(NamedTuple):
     converged: jax.Array
     history: jax.Array
     status: jax.Array
+    first_order_steps: jax.Array | int = 0
 
 
 DENSE_MAX = 2000  # unknowns + multipliers: dense LU beyond this costs seconds and gigabytes
@@ -175,7 +179,8 @@ def _solve_impl(spec, linear, z0, params, lam0, weights, *, tol, max_steps, firs
     u, lam = kkt_diff.split(w)
     x = kkt_diff.x(u)
     energy = kkt_diff.energy(u)
-    return Solution(x, spec.constraint_structure.unravel(lam), energy, residual, steps, converged, history, status)
+    return Solution(x, spec.constraint_structure.unravel(lam), energy, residual, steps, converged, history, status,
+                    fo_steps)
 
 
 def solve(

@@ -113,6 +113,7 @@ def test_rotation_invariant_chain_converges():
     problem = dg.Problem(energy, X0, constraints=lambda X, _: jnp.sum(X**2, axis=1) - 1.0)
     sol = solve(problem)
     assert float(sol.residual) <= 1e-10
+    assert int(sol.first_order_steps) == 0  # Newton alone got there: no retry reported
 
 
 def test_history_records_quadratic_convergence():
@@ -215,6 +216,7 @@ def test_warm_start_reaches_minimum_from_far_away():
     """Six charges: L-BFGS phase then Newton; the minimum is the octahedron, E = 3/2 + 12/√2."""
     sol = solve(_thomson(6, 11), warm_start="lbfgs")
     assert float(sol.residual) <= 1e-10
+    assert int(sol.first_order_steps) > 0  # the L-BFGS phase ran (and is reported)
     assert abs(float(sol.energy) - (1.5 + 12 / np.sqrt(2))) <= 1e-9
 
 

@@ -167,12 +167,15 @@ def test_cantilever_newton_steps_at_n_2048():
 def test_slightly_non_planar_elastica_converges_with_the_default_call(z):
     """Def 3.2 with the chord (0.5, 0.2, z) and T_0 = e1, T_15 = e2: the solution is a critical
     point (KKT residual), on the constraints (|T_k| = 1, h Σ T_k = chord) to round-off.
-    Negative control: Newton alone (`warm_start=None`) stops without converging."""
+    The solution is the retry's and says so (`first_order_steps` > 0, `steps` the retry's Newton
+    steps, matching its history).  Negative control: Newton alone (`warm_start=None`) stops
+    without converging."""
     chord = np.array([0.5, 0.2, z])
     problem = elastica.clamped(16, chord=chord, t_start=E1, t_end=(0.0, 1.0, 0.0))
     sol = solve(problem)
     T = np.asarray(sol.x)
     assert float(sol.residual) <= 1e-10
+    assert int(sol.first_order_steps) > 0 and len(sol.history) == int(sol.steps) + 1
     assert np.max(np.abs(np.linalg.norm(T, axis=1) - 1.0)) <= 1e-10
     assert np.max(np.abs(T.sum(axis=0) / 16 - chord)) <= 1e-10
     with pytest.raises(dg.errors.ConvergenceError, match="did not converge"):
