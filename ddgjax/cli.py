@@ -6,6 +6,7 @@
     ddgjax solve minimal-surface --mesh annulus --height 0.4 --method cotan --plot surface.png
     ddgjax sweep elastica --n 16 --param chord=0.2:0.9:50 --out chords.h5   (resumes if the file exists;
                                                                             --processes K: K local processes)
+    ddgjax sweep minimal-surface --rings 8 --param height=0.3:0.7:41 --out catenoids.h5
     ddgjax sweep-plot chords.h5 [--out chords.png]
     ddgjax bench [--quick] [NAME ...]
     ddgjax --version                        (also `python -m ddgjax --version`)
@@ -314,7 +315,8 @@ def _scalar(values):
     return values
 
 
-SWEEP_PARAMETERS = {"elastica": {"chord": _elastica_chord}, "rod": {"chord": _elastica_chord, "alpha": _scalar}}
+SWEEP_PARAMETERS = {"elastica": {"chord": _elastica_chord}, "rod": {"chord": _elastica_chord, "alpha": _scalar},
+                    "minimal-surface": {"height": _scalar}}
 """The parameters `ddgjax sweep OBJECT --param` varies: name -> (member values -> the problem's
 parameter array (B, ...))."""
 
@@ -366,7 +368,17 @@ def _sweep_template_rod(args, grid):
                        frame_start=start, frame_end=end)
 
 
-SWEEP_TEMPLATES = {"elastica": _sweep_template_elastica, "rod": _sweep_template_rod}
+def _sweep_template_minimal_surface(args, grid):
+    """The catenoid between the unit circles at z = ±H (`area.between_circles`, `--rings`) at the
+    first H of the grid (`--height` when H is not swept): the sweep's `x0` is its cylinder."""
+    from energies import area
+
+    height = float(grid["height"][0]) if "height" in grid else args.height
+    return area.between_circles(args.rings, height)
+
+
+SWEEP_TEMPLATES = {"elastica": _sweep_template_elastica, "rod": _sweep_template_rod,
+                   "minimal-surface": _sweep_template_minimal_surface}
 
 
 def _writable_file(path) -> Path:
@@ -543,7 +555,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("object", choices=sorted(SWEEP_PARAMETERS))
     sweep.add_argument("--param", type=_grid_axis, action="append", required=True, metavar="NAME=START:STOP:COUNT",
                        help="a grid axis, COUNT values from START to STOP; several give their product "
-                            "(elastica: chord, the chord's length along x)")
+                            "(elastica: chord, the chord's length along x; rod: chord, alpha; "
+                            "minimal-surface: height, the half-distance H of the circles at z = ±H)")
     sweep.add_argument("--out", required=True, metavar="FILE", help="the HDF5 file; an existing one of the same sweep is resumed")
     sweep.add_argument("--n", type=int, default=100, help="number of edges (default: 100)")
     sweep.add_argument("--length", type=float, default=1.0, help="length of the curve (default: 1)")
@@ -553,6 +566,10 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--chord", type=float, default=0.5, help="the chord (c, 0, 0) when it is not swept (default: 0.5)")
     sweep.add_argument("--alpha", type=float, default=0.7, help="rod: twist stiffness when it is not swept (default: 0.7)")
     sweep.add_argument("--twist", type=float, default=0.0, help="rod: extra twist of the end frame in radians")
+    sweep.add_argument("--rings", type=_positive_int, default=8,
+                       help="minimal-surface: the cylinder's n (n + 1 circles of 3n vertices; default: 8)")
+    sweep.add_argument("--height", type=float, default=0.45,
+                       help="minimal-surface: the half-distance H when it is not swept (default: 0.45)")
     sweep.add_argument("--chunk", type=_positive_int, default=64, help="members per batched solve (default: 64)")
     sweep.add_argument("--warm-start", choices=["previous", "none"], default="previous",
                        help="previous: a chunk starts from the last converged member before it (default); none: all from x0")

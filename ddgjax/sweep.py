@@ -12,7 +12,8 @@ copies of its last member, so every call has the same shapes), and each finished
 written to the file and flushed at once.  A member whose Newton iteration stops without
 converging (max_steps reached, or stalled) is solved once more alone from the same start with
 the L-BFGS phase first, and that solution kept if it converged: `solve`'s default
-`warm_start="auto"`, which cannot run under `vmap`.  So every member's row equals
+`warm_start="auto"`, which cannot run under `vmap` (its row then has `first_order_steps` > 0).
+So every member's row equals
 `solve(problem.with_params({**problem.params, **member}), throw=False)` from the chunk's `x0`.
 If `solve_batch` raises on a chunk, that chunk's members are solved one by one with
 `solve(..., throw=False)` so that the bad member is isolated.
@@ -61,6 +62,7 @@ JAX runs K processes.  `ddgjax sweep ... --processes K` starts K local processes
 | `multipliers` | (B, m) f8 | flat; named constraints: group `multipliers/<name>` |
 | `energy`, `residual` | (B,) f8 | |
 | `steps`, `status` | (B,) i8 | `status`: 0 converged, 1 max_steps, 2 stalled, 3 non-finite, -1 raised/not run |
+| `first_order_steps` | (B,) i8 | L-BFGS steps before Newton: > 0 where the member came from the retry |
 | `converged`, `done` | (B,) bool | |
 | `error` | (B,) str | "" for converged members |
 | `params/<name>` | (B, ...) f8 | the grid |
@@ -86,7 +88,9 @@ from .problem import Problem
 __all__ = ["run", "read", "summary", "RESULT_NAMES"]
 
 FORMAT = "ddgjax.sweep/1"
-RESULT_NAMES = ("x", "multipliers", "energy", "residual", "steps", "status", "converged", "done", "error", "params")
+SCALARS = ("energy", "residual", "steps", "first_order_steps", "status", "converged")
+"""The results with one value per member, as named in `Solution`."""
+RESULT_NAMES = ("x", "multipliers", *SCALARS, "done", "error", "params")
 WARM_STARTS = ("previous", None)
 RAISED = -1  # status of a member whose solve raised (or that was never solved)
 RETRIED = (1, 2)  # max_steps reached, stalled: `solve(warm_start="auto")` retries these with L-BFGS first
@@ -173,6 +177,7 @@ def _create(f: h5py.File, problem: Problem, grid: dict, size: int, fingerprint: 
             f.create_dataset(f"{name}/{key}" if key else name, shape=(size, *leaf.shape), dtype="f8", fillvalue=np.nan)
     for name in ("energy", "residual"):
         f.create_dataset(name, shape=(size,), dtype="f8", fillvalue=np.nan)
+    _create_first_order_steps(f, size)
     f.create_dataset("steps", shape=(size,), dtype="i8", fillvalue=0)
     f.create_dataset("status", shape=(size,), dtype="i8", fillvalue=RAISED)
     f.create_dataset("converged", shape=(size,), dtype=bool, fillvalue=False)
@@ -183,6 +188,10 @@ def _create(f: h5py.File, problem: Problem, grid: dict, size: int, fingerprint: 
     f.attrs.update({"format": FORMAT, "fingerprint": _digest(*fingerprint.items()), **{f"fingerprint: {k}": v for k, v in fingerprint.items()},
                     **{k: ("None" if v is None else v) for k, v in attrs.items()}})
     f.flush()
+
+
+def _create_first_order_steps(f: h5py.File, size: int) -> None:
+    f.create_dataset("first_order_steps", shape=(size,), dtype="i8", fillvalue=0)
 
 
 def _check_resumable(f: h5py.File, out, fingerprint: dict, size: int) -> None:
@@ -209,6 +218,8 @@ def _open(out, problem: Problem, grid: dict, size: int, fingerprint: dict, attrs
             except BaseException:
                 f.close()
                 raise
+            if "first_order_steps" not in f:  # a file written before the column existed
+                _create_first_order_steps(f, size)
             return f
         path.parent.mkdir(parents=True, exist_ok=True)
         f = h5py.File(path, "w")
@@ -223,7 +234,7 @@ def _write(f: h5py.File, index: np.ndarray, rows: dict) -> None:
     for name, tree in (("x", rows["x"]), ("multipliers", rows["multipliers"])):
         for key, leaf in _leaves(tree):
             f[f"{name}/{key}" if key else name][index] = leaf
-    for name in ("energy", "residual", "steps", "status", "converged", "error"):
+    for name in (*SCALARS, "error"):
         f[name][index] = rows[name]
     f["done"][index] = True
     f.flush()
@@ -232,7 +243,7 @@ def _write(f: h5py.File, index: np.ndarray, rows: dict) -> None:
 def read(path) -> dict:
     """The stored sweep at `path` as a dict of NumPy arrays, member axis first: `x`,
     `multipliers` (an array, or a dict by constraint name), `energy`, `residual`, `steps`,
-    `status`, `converged`, `done`, `error` (an array of str), `params` (dict by name), every
+    `first_order_steps`, `status`, `converged`, `done`, `error` (an array of str), `params` (dict by name), every
     parameter of the grid also under its own name (`read(p)["chord"]`) unless that name is one
     of the above, and `attrs` (the file's attributes: problem name, options, fingerprint).
     Members not yet solved have `done == False` and NaN in the float arrays.
@@ -284,7 +295,7 @@ def _rows_of(sol, count: int, tol: float) -> dict:
     """The first `count` members of a batched `Solution` as rows to write."""
     take = lambda tree: jax.tree_util.tree_map(lambda a: np.array(a)[:count], tree)  # noqa: E731
     rows = {"x": take(sol.x), "multipliers": take(sol.multipliers)}
-    for name in ("energy", "residual", "steps", "status", "converged"):
+    for name in SCALARS:
         rows[name] = np.array(getattr(sol, name))[:count]
     rows["error"] = np.array(["" if ok else _failure_message(float(r), int(s), int(st), tol)
                               for ok, r, s, st in zip(rows["converged"], rows["residual"], rows["steps"], rows["status"])],
@@ -304,8 +315,9 @@ def _solve_one(template: Problem, params: dict, options: dict, warm_start: str |
         lam = problem.constraint_structure.unravel(np.zeros(problem.n_constraints))
         message = f"{type(error).__name__}: {' '.join(str(error).split())}"
         return {"x": jax.tree_util.tree_map(nan, problem.x0), "multipliers": jax.tree_util.tree_map(nan, lam),
-                "energy": np.nan, "residual": np.nan, "steps": 0, "status": RAISED, "converged": False, "error": message}
-    row = {name: getattr(sol, name) for name in ("x", "multipliers", "energy", "residual", "steps", "status", "converged")}
+                "energy": np.nan, "residual": np.nan, "steps": 0, "first_order_steps": 0, "status": RAISED,
+                "converged": False, "error": message}
+    row = {name: getattr(sol, name) for name in ("x", "multipliers", *SCALARS)}
     row = jax.tree_util.tree_map(np.asarray, row)
     row["error"] = "" if bool(row["converged"]) else _failure_message(float(row["residual"]), int(row["steps"]), int(row["status"]), tol)
     return row
@@ -313,7 +325,7 @@ def _solve_one(template: Problem, params: dict, options: dict, warm_start: str |
 
 def _stack(rows: list[dict]) -> dict:
     stacked = {name: jax.tree_util.tree_map(lambda *a: np.stack(a), *[r[name] for r in rows]) for name in ("x", "multipliers")}
-    for name in ("energy", "residual", "steps", "status", "converged"):
+    for name in SCALARS:
         stacked[name] = np.array([r[name] for r in rows])
     stacked["error"] = np.array([r["error"] for r in rows], dtype=object)
     return stacked
@@ -340,7 +352,7 @@ def _solve_chunk(template: Problem, grid: dict, index: np.ndarray, chunk: int, o
 def _set_row(rows: dict, i: int, row: dict) -> None:
     for name in ("x", "multipliers"):
         jax.tree_util.tree_map(lambda stacked, value: stacked.__setitem__(i, value), rows[name], row[name])
-    for name in ("energy", "residual", "steps", "status", "converged", "error"):
+    for name in (*SCALARS, "error"):
         rows[name][i] = row[name]
 
 

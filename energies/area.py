@@ -36,11 +36,13 @@ triangle degenerates.
 
 from __future__ import annotations
 
+import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
 from ddgjax import intrinsic
+from ddgjax._checks import check_positive
 from ddgjax.errors import ConvergenceError, DDGError, DegenerateFaceError, InvalidInputError, NonFiniteError
 from ddgjax.laplace import (
     check_nondegenerate,
@@ -54,8 +56,8 @@ from ddgjax.mesh.lengths import squared_side_lengths, triangle_area
 from .dirichlet import dirichlet_solve
 
 __all__ = ["METHODS", "cap_volume", "cone_volume", "enclosed_volume", "face_area", "face_volume", "harmonic_iteration",
-           "interior_residual", "minimal_surface", "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial",
-           "with_volume"]
+           "interior_residual", "between_circles", "minimal_surface", "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial",
+           "surface_between_circles", "with_volume"]
 
 METHODS = ("auto", "cotan", "newton", "delaunay")
 LOOSE_TOL = 1e-4  # the "auto" method's switch from Fig 6.5 to Newton, relative to the boundary's size
@@ -91,6 +93,41 @@ def simplicial(V, F, boundary=None) -> dg.Problem:
     fixed = np.zeros(V.shape, dtype=bool)
     fixed[b] = True
     return dg.Problem(dg.local_sum(face_area, F), V, fixed=fixed, name=f"simplicial area (nv={len(V)}, nf={len(F)})")
+
+
+def between_circles(n: int, height: float = 0.45) -> dg.Problem:
+    """The catenoid's problem (Sec 6.4, Thm 6.7): the area of the triangulated cylinder
+    `dg.mesh.builtin.cylinder(n, 1, 1)` spanned between the unit circles at z = ±H, with the
+    half-distance H a parameter, `params={"height": H}`.
+
+    The unknowns are `(x, y, ζ)` per vertex and the surface is `X = (x, y, H ζ)`: ζ = ±1 on the
+    fixed circles, so every H shares one declaration (`with_params`, `solve_batch`, sweeps) and
+    `surface_between_circles(x, H)` gives the positions.  `x0` is the cylinder of radius 1, from
+    which `solve` finds the stable catenoid (at n = 8 for H up to 0.65); the smooth catenoid
+    r = c cosh(z/c) exists while c cosh(H/c) = 1 has a root, up to H* ≈ 0.6627 (the fold), and
+    beyond it the solve does not converge.
+
+    **Raises:** `InvalidInputError` for n < 1 or a height that is not finite and positive.
+    """
+    if int(n) < 1:
+        raise InvalidInputError(f"between_circles needs n >= 1 (rings of the cylinder), got {n}")
+    check_positive(height, "between_circles: height")
+    V, F = dg.mesh.builtin.cylinder(int(n), 1.0, 1.0)
+    fixed = np.zeros(V.shape, dtype=bool)
+    fixed[np.abs(np.abs(V[:, 2]) - 1.0) < 1e-12] = True
+    energy = dg.local_sum(_face_area_between_circles, F)
+    return dg.Problem(energy, V, params={"height": float(height)}, fixed=fixed,
+                      name=f"catenoid between circles (cylinder({int(n)}), {len(F)} faces)")
+
+
+def _face_area_between_circles(P: Float[Array, "3 3"], params) -> Float[Array, ""]:
+    """The area of the face with corners `(x, y, H ζ)` (`between_circles`)."""
+    return face_area(surface_between_circles(P, params["height"]))
+
+
+def surface_between_circles(x: Float[Array, "*n 3"], height) -> Float[Array, "*n 3"]:
+    """The positions `(x, y, H ζ)` of `between_circles`' unknowns `(x, y, ζ)`."""
+    return x * jnp.asarray([1.0, 1.0, 1.0]).at[2].set(height)
 
 
 def interior_residual(L, V, fixed: np.ndarray) -> float:
@@ -458,8 +495,6 @@ def with_volume(V, F, volume, boundary=None) -> dg.Problem:
     alike, naming it, or the normals pointing into the volume: reverse F); `InvalidInputError`
     (`volume` not finite and positive, or a boundary-loop vertex not fixed, naming it).
     """
-    from ddgjax._checks import check_positive
-
     V, F, b = _checked(V, F, boundary)
     check_positive(volume, "with_volume: volume")
     fixed = _mask(b, len(V))

@@ -227,3 +227,11 @@ def test_default_minimal_surface_on_a_wavy_tall_dome_fails_with_a_convergence_er
     V, F, b = dg.mesh.builtin.tall_dome(0, wave=0.3)
     with pytest.raises(ConvergenceError, match="degenerated"):
         area.minimal_surface(V, F, b)
+
+
+@pytest.mark.parametrize("args, message", [((0,), "n >= 1"), ((4, -0.5), "height"), ((4, float("nan")), "height")])
+def test_between_circles_rejects_bad_input(args, message):
+    """`area.between_circles(n, height)`: a cylinder without rings or a height that is not finite
+    and positive raises `InvalidInputError` naming the argument."""
+    with pytest.raises(dg.errors.InvalidInputError, match=message):
+        area.between_circles(*args)

@@ -264,6 +264,31 @@ def test_cli_sweep_rod_over_the_twist_stiffness(tmp_path, capsys):
     assert np.all(np.diff(np.abs(theta[:, 0])) < 0), theta[:, 0]
 
 
+def test_cli_sweep_minimal_surface_over_the_height_fails_beyond_the_fold(tmp_path, capsys):
+    """`ddgjax sweep minimal-surface --param height=...`: catenoids between the unit circles at
+    z = ±H (Sec 6.4).  Below the fold H* ≈ 0.6627 every member converges (residual ≤ 1e-10), the
+    neck radius is the smooth catenoid's c (c cosh(H/c) = 1, the stable root) to the mesh's
+    accuracy and falls with H, the area grows; beyond the fold there is no catenoid and those
+    members are recorded as failed, with their message, without stopping the sweep.  Negative
+    control: the start (the cylinder, radius 1) misses c by far more."""
+    from scipy.optimize import brentq
+
+    out = tmp_path / "heights.h5"
+    argv = ["sweep", "minimal-surface", "--rings", "4", "--param", "height=0.45:0.75:3", "--chunk", "3", "--max-steps", "30",
+            "--out", str(out), "--no-progress"]
+    assert cli.main(argv) == 0
+    assert "3 members: 2 converged, 1 failed" in capsys.readouterr().out
+    data = sweep.read(out)
+    H, ok = data["height"], data["converged"]
+    assert np.array_equal(ok, H < 0.6627) and float(data["residual"][ok].max()) <= 1e-10
+    assert all("did not converge" in e for e in data["error"][~ok]) and data["first_order_steps"].shape == (3,)
+    middle = np.abs(data["x"][0, :, 2]) < 1e-12  # the unknowns are (x, y, ζ): ζ = 0 on the middle circle
+    neck = np.linalg.norm(data["x"][ok][:, middle, :2], axis=2).mean(axis=1)
+    smooth = np.array([brentq(lambda c, h=h: c * np.cosh(h / c) - 1.0, 0.55, 1.0) for h in H[ok]])
+    assert np.max(np.abs(neck - smooth)) < 0.03 and np.all(np.diff(neck) < 0) and np.all(np.diff(data["energy"][ok]) > 0)
+    assert np.min(np.abs(1.0 - smooth)) > 0.03  # the cylinder's radius fails the bound
+
+
 @pytest.mark.parametrize("argv, message", [
     (["--param", "chord=0.2:0.8"], "sweep: argument --param: expected NAME=START:STOP:COUNT"),
     (["--param", "chord=0.2:0.8:0"], "COUNT must be a positive integer"),

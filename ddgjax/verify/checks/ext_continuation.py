@@ -28,8 +28,7 @@ from scipy.special import ellipe, ellipk
 
 import ddgjax as dg
 from ddgjax.verify import check
-from energies import elastica
-from energies.area import face_area
+from energies import area, elastica
 from solvers import continuation
 
 H_START = 0.45  # the branch starts on the stable catenoid at this half-distance
@@ -42,16 +41,13 @@ def fold_half_distance() -> float:
 
 
 def catenoid_family(n: int):
-    """`(problem_of, x0)`: the area of `cylinder(n)` with its z-coordinates scaled by the
-    parameter, `X = (x, y, H·ζ)`, ζ = ±1 on the fixed circles (H enters through `params`, so
+    """`(problem_of, x0)`: `area.between_circles(n)` at the half-distance H (its parameter, so
     every H shares one declaration); x0 the stable smooth catenoid at `H_START` on that mesh."""
-    V, F = dg.mesh.builtin.cylinder(n, 1.0, 1.0)
-    fixed = np.zeros(V.shape, dtype=bool)
-    fixed[np.abs(np.abs(V[:, 2]) - 1.0) < 1e-12] = True
-    energy = dg.local_sum(lambda P, params: face_area(P * jnp.array([1.0, 1.0, params["H"]])), F)
+    family = area.between_circles(n, H_START)
+    V = np.asarray(family.x0)
 
     def problem_of(H):
-        return dg.Problem(energy, V, params={"H": H}, fixed=fixed, name=f"catenoid on cylinder({n})")
+        return family.with_params({"height": H})
 
     c = brentq(lambda c: c * np.cosh(H_START / c) - 1.0, 0.55, 1.0)  # the stable root
     x0 = V.copy()
