@@ -13,11 +13,18 @@ has local minima there; measured with `warm_start=None` at 98 and 386 vertices: 
 88 and 100 steps at residuals 0.067 and 0.042), so the
 default `warm_start="auto"` solves again from x0 with up to 50 augmented-Lagrangian L-BFGS steps
 before Newton; "(after retry)" in the steps column says that the retry's solution was returned
-(detected by its history not starting at the KKT residual of x0; when the retry fails too,
-`solve` returns the first run, unmarked, and the time includes both).  `steps` is `Solution.steps`, the Newton steps
-of the returned run: after a retry it counts neither the failed first run (100 Newton steps) nor
-the L-BFGS phase (the `Solution` does not report them), so it is not comparable to scipy's
-iterations then; the time is the whole call, both runs included.  Its "residual" is the scaled
+(`Solution.first_order_steps` > 0, printed with the L-BFGS step count; when the retry fails
+too, `solve` returns the first run, unmarked, and the time includes both).  `steps` is
+`Solution.steps`, the Newton steps of the returned run: after a retry it does not count the
+failed first run (100 Newton steps), so it is not comparable to scipy's iterations then; the
+time is the whole call, both runs included.
+
+**Refined bubble** (`--refine`, Surface Evolver's `r` then `g`).  `energies.refine.refine` with
+Loop subdivision: the cube subdivided twice (98 vertices) solved, then each level started from
+the previous solution Loop-subdivided (a curved, non-degenerate start: midpoint subdivision
+would leave the new vertices on the old flat faces, where the area has exactly flat tangential
+directions and Newton stalls as from the cube); every level from the first of `--refine` on is
+timed from its own start, trust-constr from the same start.  Its "residual" is the scaled
 max-norm KKT residual of `solve`, "volume error" |vol − 4π/3|.
 
 **Anchor (scipy).**  The same `problem.energy` and `problem.constraints` (jit-compiled JAX),
@@ -107,6 +114,7 @@ from energies import area, willmore
 from solvers import minimize, solve
 
 SPHERE_VOLUME = 4.0 * np.pi / 3.0  # the unit ball: p·r = 2
+REFINE_FROM = 2  # the refined bubbles start from the cube subdivided this often (98 vertices)
 
 
 def peak_mb() -> float:
@@ -202,24 +210,42 @@ class TrustConstr:
 
 
 def bubble_row(level: int, args) -> list[str]:
+    """The bubble from the flat cube subdivided `level` times (module docstring)."""
     V, F = cube_start(level)
-    problem = area.with_volume(V, F, SPHERE_VOLUME)
-    repeats = args.repeats if len(V) <= 50_000 else 1
+    return bubble_rows(area.with_volume(V, F, SPHERE_VOLUME), F, "ddgjax solve", args)
+
+
+def refined_bubble_rows(args) -> list[str]:
+    """The bubble by refinement (`energies.refine.refine`, Loop subdivision): the cube subdivided
+    `REFINE_FROM` times solved, then each level started from the last solution subdivided;
+    every level from `args.refine[0]` on is timed from its own start (scipy from the same)."""
+    from energies.refine import refine
+
+    V, F = cube_start(REFINE_FROM)
+    problem_of = lambda V, F: area.with_volume(V, F, SPHERE_VOLUME)  # noqa: E731
+    rows = []
+    for level in refine(problem_of, V, F, levels=max(args.refine) - REFINE_FROM, scheme="loop", tol=args.tol, throw=False):
+        if len(level.V) >= 6 * 4 ** min(args.refine) + 2:
+            rows += bubble_rows(problem_of(level.V, level.F), level.F, "ddgjax solve, refined", args)
+    return rows
+
+
+def bubble_rows(problem, F, label: str, args) -> list[str]:
+    """The rows of `solve` and of trust-constr on one bubble problem (faces F), from its `x0`."""
+    nv = len(problem.x0)
+    repeats = args.repeats if nv <= 50_000 else 1
     sol, compile_s, solve_s = timed(lambda: solve(problem, tol=args.tol, throw=False), repeats)
-    start = float(solve(problem, max_steps=0, warm_start=None, throw=False).residual)  # the KKT residual at x0
-    history = np.asarray(sol.history)
-    retry = bool(history.size and abs(float(history[0]) - start) > 1e-12 * max(start, 1.0))
     p = float(sol.multipliers["volume"][0])
     state = "" if bool(sol.converged) else " not converged"
-    rows = [f"| bubble | {len(V)} | ddgjax solve | {compile_s:.1f} | {solve_s:.2f}{state} | {int(sol.steps)}"
-            f"{' (after retry)' if retry else ''} | {float(sol.residual):.1e} | "
-            f"{abs(area.enclosed_volume(np.asarray(sol.x), F) - SPHERE_VOLUME):.1e} | {float(sol.energy):.6f} | "
-            f"p·r = {p:.5f} | {peak_mb():.0f} | |"]
+    retry = f" (after retry: {int(sol.first_order_steps)} L-BFGS steps)" if int(sol.first_order_steps) else ""
+    rows = [f"| bubble | {nv} | {label} | {compile_s:.1f} | {solve_s:.2f}{state} | {int(sol.steps)}{retry} | "
+            f"{float(sol.residual):.1e} | {abs(area.enclosed_volume(np.asarray(sol.x), F) - SPHERE_VOLUME):.1e} | "
+            f"{float(sol.energy):.6f} | p·r = {p:.5f} | {peak_mb():.0f} | |"]
     print(rows[0], flush=True)
-    if len(V) > args.scipy_max:
-        rows.append(f"| bubble | {len(V)} | scipy trust-constr | | skipped (nv > --scipy-max {args.scipy_max}) | | | | | | | |")
+    if nv > args.scipy_max:
+        rows.append(f"| bubble | {nv} | scipy trust-constr | | skipped (nv > --scipy-max {args.scipy_max}) | | | | | | | |")
     else:
-        rows.append(scipy_row("bubble", len(V), TrustConstr(problem, "volume"), args.tol, args.scipy_budget, solve_s,
+        rows.append(scipy_row("bubble", nv, TrustConstr(problem, "volume"), args.tol, args.scipy_budget, solve_s,
                               lambda r: f"p·r = {r['pressure']:.5f}"))
     print(rows[-1], flush=True)
     return rows
@@ -262,6 +288,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="bubbles up to ~6·10³ vertices, the coarse torus")
     ap.add_argument("--levels", type=int, nargs="*", help="subdivisions of the cube (nv = 6·4^k + 2); none: no bubbles")
+    ap.add_argument("--refine", type=int, nargs="*", help="levels of the refined bubbles (from the cube subdivided "
+                    f"{REFINE_FROM} times, Loop subdivision between levels); none: no refined bubbles")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--tol", type=float, default=1e-10, help="KKT tolerance of the bubbles (both solvers)")
     ap.add_argument("--scipy-max", type=int, default=30_000, help="largest vertex count given to trust-constr")
@@ -272,6 +300,8 @@ def main():
     ap.add_argument("--no-torus", action="store_true")
     args = ap.parse_args()
     levels = args.levels if args.levels is not None else ([4, 5] if args.quick else [4, 5, 6, 7])
+    if args.refine is None:
+        args.refine = [4, 5] if args.quick else [4, 5, 6, 7]
     tori = [] if args.no_torus else [tuple(map(int, s.split("x"))) for s in (args.torus or (["24x12"] if args.quick else ["24x12", "48x24"]))]
 
     load, cores = os.getloadavg()[0], os.cpu_count() or 1
@@ -280,6 +310,8 @@ def main():
     rows = []
     for level in levels:
         rows += bubble_row(level, args)
+    if args.refine:
+        rows += refined_bubble_rows(args)
     for m, n in tori:
         rows += torus_rows(m, n, args)
     print("\n| problem | vertices | solver | compile s | solve s | steps | residual | volume error | area / W | "
