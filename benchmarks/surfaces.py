@@ -77,6 +77,17 @@ converge to the same area and p·r (trust-constr in 37 and 51 iterations, to opt
 faster than `solve`'s retry path).  The flat cube is a hard start for both; the full sizes
 (24578, 98306 vertices) were not run to the end in the time available.
 
+Refined bubble (`--levels --refine 4 5 6 --no-torus --repeats 2 --scipy-max 7000
+--scipy-budget 60`, 2 cores, load 0.8, 2026-12-02), each level from its own Loop-subdivided start:
+1538 vertices `solve` 0.09 s (4 Newton steps, KKT 4.7e-12, p·r = 2.00087) against trust-constr
+4.70 s (35 iterations, same area, stopped on xtol at optimality 2.2e-10): 53×; 6146 vertices
+2.47 s (11 steps, 5.4e-16, p·r = 2.00022) against 21.9 s (14 iterations, 5.2e-11): 8.9×; 24578
+vertices 4.58 s (7 steps, 3.3e-11, p·r = 2.00005; trust-constr not run).  p·r − 2 falls by 4.0
+per level (order 2 in the edge length).  98306 vertices (a separate run of the same chain):
+15 steps, 2.000014, about 125 s and 7 GB, of which 73 s and most of the memory are one
+Levenberg–Marquardt step (the complex SuperLU factorisation of K + i√ν I, `SparseDirect.
+lm_solve_matrix`); the Newton factorisations take 1.3–1.4 s each.
+
 **Surface Evolver.**  Its documentation of the cube example (`cube.htm`, "Cube evolving into a
 sphere") was found with the search tools, but the stored copies end before the run; the
 Hessian chapter's transcript shows the refined cube (194 vertices) taking a fixed `g 5` (five
