@@ -55,9 +55,9 @@ from ddgjax.mesh.lengths import squared_side_lengths, triangle_area
 
 from .dirichlet import dirichlet_solve
 
-__all__ = ["METHODS", "cap_volume", "cone_volume", "enclosed_volume", "face_area", "face_volume", "harmonic_iteration",
-           "interior_residual", "between_circles", "minimal_surface", "minimal_surface_delaunay", "pinkall_polthier_step", "simplicial",
-           "surface_between_circles", "with_volume"]
+__all__ = ["METHODS", "between_circles", "cap_volume", "cone_volume", "enclosed_volume", "face_area", "face_volume",
+           "harmonic_iteration", "interior_residual", "minimal_surface", "minimal_surface_delaunay",
+           "pinkall_polthier_step", "simplicial", "surface_between_circles", "with_volume"]
 
 METHODS = ("auto", "cotan", "newton", "delaunay")
 LOOSE_TOL = 1e-4  # the "auto" method's switch from Fig 6.5 to Newton, relative to the boundary's size
@@ -127,7 +127,7 @@ def _face_area_between_circles(P: Float[Array, "3 3"], params) -> Float[Array, "
 
 def surface_between_circles(x: Float[Array, "*n 3"], height) -> Float[Array, "*n 3"]:
     """The positions `(x, y, H ζ)` of `between_circles`' unknowns `(x, y, ζ)`."""
-    return x * jnp.asarray([1.0, 1.0, 1.0]).at[2].set(height)
+    return x * jnp.array([1.0, 1.0, height])
 
 
 def interior_residual(L, V, fixed: np.ndarray) -> float:
