@@ -84,9 +84,11 @@ Refined bubble (`--levels --refine 4 5 6 --no-torus --repeats 2 --scipy-max 7000
 2.47 s (11 steps, 5.4e-16, p·r = 2.00022) against 21.9 s (14 iterations, 5.2e-11): 8.9×; 24578
 vertices 4.58 s (7 steps, 3.3e-11, p·r = 2.00005; trust-constr not run).  p·r − 2 falls by 4.0
 per level (order 2 in the edge length).  98306 vertices (a separate run of the same chain):
-15 steps, 2.000014, about 125 s and 7 GB, of which 73 s and most of the memory are one
-Levenberg–Marquardt step (the complex SuperLU factorisation of K + i√ν I, `SparseDirect.
-lm_solve_matrix`); the Newton factorisations take 1.3–1.4 s each.
+15 steps, p·r = 2.000014, about 125 s and 7 GB, of which 73 s and most of the memory were one
+Levenberg–Marquardt step (then a complex SuperLU factorisation of K + i√ν I); with that step now
+one Pardiso factorisation of the real system [[K, √νI], [√νI, −K]] (`solvers/_direct.py`) it
+took 15.7 s at a peak resident set of 2.7 GB (26 Newton steps in that run, 1.3–1.4 s per
+factorisation).
 
 **Surface Evolver.**  Its documentation of the cube example (`cube.htm`, "Cube evolving into a
 sphere") was found with the search tools, but the stored copies end before the run; the

@@ -36,7 +36,12 @@ area Hessian of a 180² grid Pardiso factorises in 0.6× the time scipy's `splu`
   `LDLᵀ` without pivoting under a nested-dissection ordering made once, its inertia from D;
   a (nearly) zero pivot falls back to
 - `"superlu"`: SuperLU (scipy `splu`, COLAMD ordering, partial pivoting): any nonsingular K,
-  inertia unknown; also the complex solves of the Levenberg–Marquardt fallback.
+  inertia unknown; also the complex solves of the Levenberg–Marquardt fallback without Pardiso.
+
+The Levenberg–Marquardt fallback's `(K + i√ν I)⁻¹` is, with Pardiso, one real symmetric
+factorisation of `[[K, √ν I], [√ν I, −K]]` with weighted matching (`_solve_shifted_real`); a
+complex SuperLU factorisation of K + i√ν I took 73 s and several GB on the 98,306-vertex bubble
+(`benchmarks/surfaces.py`), against a Newton step's 1.4 s.
 """
 
 from __future__ import annotations
@@ -147,6 +152,10 @@ class Factorisation:
 
 
 TRIM_MIN_ENTRIES = 100_000  # upper-triangle entries above which a factorisation returns the heap's free pages first
+SADDLE_POINT_IPARM = {1: 1, 2: 2, 10: 8, 11: 1, 13: 1, 21: 1}
+"""Pardiso options (1-based) for `_solve_shifted_real`: user-set (1), METIS ordering (2), pivot
+perturbation 1e-8 (10), and symmetric weighted matching and scaling (11, 13) with Bunch–Kaufman
+pivots (21), MKL's advice for saddle-point matrices."""
 LIVE_PER_MEMBER = 1  # factorisations kept per batch member: the current one (a Newton step's is dead at the next)
 PIVOT_FLOOR = 1e-14  # an LDLᵀ pivot below this, relative to the largest, falls back to LU with pivoting
 
@@ -212,24 +221,33 @@ class HostFactors:
 
         return Factorisation(spla.splu(A, permc_spec="COLAMD").solve)
 
-    def _new_pardiso_handle(self):
-        """A Pardiso handle with its analysis of the pattern made (phase 11), freed with it."""
+    def _new_pardiso_handle(self, structure=None, values=None, iparm: dict | None = None):
+        """A Pardiso handle with its analysis (phase 11) of K's upper triangle, or of another
+        upper-triangle CSR `structure = (indptr, indices, ...)` with `values` (read by the
+        weighted matching), made; freed with it.  `iparm`: options (1-based, as MKL numbers
+        them), used only with iparm(1) = 1 (else Pardiso's defaults)."""
         import pypardiso
 
         handle = pypardiso.PyPardisoSolver(mtype=-2)
         handle.libmkl.MKL_Set_Num_Threads(PARDISO_THREADS)
         handle.set_iparm(12, 0)  # CSR (of the upper triangle)
-        self._pardiso_call(handle, 11, np.zeros(self.upper.size), np.zeros(self.size))
+        for i, value in (iparm or {}).items():
+            handle.iparm[i - 1] = value
+        indptr = self.upper_indptr if structure is None else structure[0]
+        values = np.zeros(indptr[-1] - 1) if values is None else values
+        self._pardiso_call(handle, 11, values, np.zeros(indptr.size - 1), structure)
         weakref.finalize(handle, _release_pardiso, handle._mkl_pardiso, handle.pt, handle.iparm, handle._pt_type[0])
         return handle
 
-    def _pardiso_call(self, handle, phase: int, values: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """One call of MKL's `pardiso` on the upper-triangle CSR with these values: phase 11
-        (analysis), 22 (numeric factorisation) or 33 (solve)."""
+    def _pardiso_call(self, handle, phase: int, values: np.ndarray, b: np.ndarray, structure=None) -> np.ndarray:
+        """One call of MKL's `pardiso` on the upper-triangle CSR with these values (K's, or those
+        of `structure = (indptr, indices, ...)`): phase 11 (analysis), 22 (numeric
+        factorisation) or 33 (solve)."""
         import ctypes
 
         from pypardiso.pardiso_wrapper import PyPardisoError
 
+        indptr, indices = (self.upper_indptr, self.upper_indices) if structure is None else structure[:2]
         b = np.asfortranarray(b, dtype=np.float64)
         x = np.zeros_like(b)
         error = ctypes.c_int32(0)
@@ -238,8 +256,8 @@ class HostFactors:
         handle._mkl_pardiso(
             handle.pt.ctypes.data_as(ctypes.POINTER(handle._pt_type[0])), one, one,
             ctypes.byref(ctypes.c_int32(-2)), ctypes.byref(ctypes.c_int32(phase)),
-            ctypes.byref(ctypes.c_int32(self.size)), values.ctypes.data_as(f64),
-            self.upper_indptr.ctypes.data_as(i32), self.upper_indices.ctypes.data_as(i32),
+            ctypes.byref(ctypes.c_int32(indptr.size - 1)), values.ctypes.data_as(f64),
+            indptr.ctypes.data_as(i32), indices.ctypes.data_as(i32),
             handle.perm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(1 if b.ndim == 1 else b.shape[1])),
             handle.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),
             b.ctypes.data_as(f64), x.ctypes.data_as(f64), ctypes.byref(error),
@@ -341,7 +359,10 @@ class HostFactors:
 
     def solve_shifted(self, values: np.ndarray, shift: np.ndarray, b: np.ndarray) -> np.ndarray:
         """`(K + i·shift·I)⁻¹ b` for real values (..., nnz) of K, shifts (...) and right-hand sides
-        (..., size), factorised and solved at once, kept nowhere: the Levenberg–Marquardt fallback."""
+        (..., size), factorised and solved at once, kept nowhere: the Levenberg–Marquardt fallback.
+
+        With Pardiso, as the real symmetric system of twice the size (`_solve_shifted_real`);
+        otherwise one complex SuperLU factorisation."""
         values, b = np.asarray(values), np.asarray(b)
         flat_v = values.reshape(-1, values.shape[-1])
         flat_s = np.asarray(shift).reshape(-1)
@@ -349,10 +370,52 @@ class HostFactors:
         diagonal = self.pattern.diagonal
         out = []
         for v, s, r in zip(flat_v, flat_s, flat_b):
+            if self.factoriser == "pardiso":
+                out.append(self._solve_shifted_real(v, float(s), r))
+                continue
             shifted = v.astype(np.complex128)
             shifted[diagonal] += 1j * s
             out.append(self._lu(self.matrix(shifted)).solve(r))
         return np.stack(out).reshape(b.shape)
+
+    def _solve_shifted_real(self, values: np.ndarray, s: float, b: np.ndarray) -> np.ndarray:
+        """`(K + isI)⁻¹ b` from the real symmetric system (indefinite; nonsingular for s ≠ 0, its
+        square being diag(K² + s², K² + s²))
+
+            [[K, sI], [sI, −K]] [x; z] = [Re b; Im b],   (K + isI)⁻¹ b = x − i z
+
+        (the real and imaginary parts of (K + isI)(x + iy) = b, z = −y), factorised by Pardiso
+        with weighted matching and scaling (`SADDLE_POINT_IPARM`) in a handle of its own."""
+        size = self.size
+        indptr, indices, positions = self.shifted_structure
+        upper = values[self.upper]
+        doubled = np.empty(positions.size)
+        doubled[positions] = np.concatenate([upper, np.full(size, s), -upper])
+        with self._lock:
+            handle = self._new_pardiso_handle(self.shifted_structure, doubled, SADDLE_POINT_IPARM)
+            self._pardiso_call(handle, 22, doubled, np.zeros(2 * size), self.shifted_structure)
+            xz = self._pardiso_call(handle, 33, doubled, np.concatenate([b.real, b.imag]), self.shifted_structure)
+        return xz[:size] - 1j * xz[size:]
+
+    @functools.cached_property
+    def shifted_structure(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The upper-triangle CSR `(indptr, indices)` (1-based) of `[[K, sI], [sI, −K]]`, and the
+        positions in its values of `[K's upper values, the couplings s, −K's upper values]`:
+        row i holds K's row i then the coupling at column size + i, row size + i K's row i
+        shifted by size."""
+        size = self.size
+        counts = np.diff(self.upper_indptr)
+        indptr = np.concatenate([[1], 1 + np.cumsum(np.concatenate([counts + 1, counts]))]).astype(np.int32)
+        row_of = np.repeat(np.arange(size), counts)
+        within = np.arange(self.upper.size) - (self.upper_indptr[row_of] - 1)
+        top = indptr[row_of] - 1 + within
+        coupling = indptr[1 : size + 1] - 2
+        bottom = indptr[size + row_of] - 1 + within
+        indices = np.empty(indptr[-1] - 1, np.int32)
+        indices[top] = self.upper_indices
+        indices[coupling] = size + 1 + np.arange(size)
+        indices[bottom] = self.upper_indices + size
+        return indptr, indices, np.concatenate([top, coupling, bottom])
 
 
 def host_factors(pattern: SparsePattern, factoriser: str) -> HostFactors:
@@ -432,8 +495,8 @@ class SparseDirect(AssembledSparse):
         return jax.lax.custom_linear_solve(lambda v: self.matvec(values, v), b, host_solve, symmetric=True)
 
     def lm_solve_matrix(self, K, nu, R):
-        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric), one complex SuperLU solve;
-        the complex matrix is made on the host (no complex copy of K on the device)."""
+        """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric), one host solve
+        (`HostFactors.solve_shifted`): no complex copy of K on the device."""
         out = jax.ShapeDtypeStruct(R.shape, jnp.complex128)
         shift = jnp.broadcast_to(jnp.sqrt(nu), K.shape[:-1])
         return -jnp.real(jax.pure_callback(self.host.solve_shifted, out, K, shift, R, vmap_method="broadcast_all"))
