@@ -386,15 +386,14 @@ class HostFactors:
 
         (the real and imaginary parts of (K + isI)(x + iy) = b, z = −y), factorised by Pardiso
         with weighted matching and scaling (`SADDLE_POINT_IPARM`) in a handle of its own."""
-        size = self.size
-        indptr, indices, positions = self.shifted_structure
+        size, structure = self.size, self.shifted_structure
         upper = values[self.upper]
-        doubled = np.empty(positions.size)
-        doubled[positions] = np.concatenate([upper, np.full(size, s), -upper])
-        with self._lock:
-            handle = self._new_pardiso_handle(self.shifted_structure, doubled, SADDLE_POINT_IPARM)
-            self._pardiso_call(handle, 22, doubled, np.zeros(2 * size), self.shifted_structure)
-            xz = self._pardiso_call(handle, 33, doubled, np.concatenate([b.real, b.imag]), self.shifted_structure)
+        doubled = np.empty(structure[2].size)
+        doubled[structure[2]] = np.concatenate([upper, np.full(size, s), -upper])
+        # the matching reads the values, so each solve analyses anew, in a handle of its own (no lock)
+        handle = self._new_pardiso_handle(structure, doubled, SADDLE_POINT_IPARM)
+        self._pardiso_call(handle, 22, doubled, np.zeros(2 * size), structure)
+        xz = self._pardiso_call(handle, 33, doubled, np.concatenate([b.real, b.imag]), structure)
         return xz[:size] - 1j * xz[size:]
 
     @functools.cached_property

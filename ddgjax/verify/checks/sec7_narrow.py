@@ -33,6 +33,7 @@ from ddgjax import intrinsic
 from ddgjax.plot import save_figure
 from ddgjax.plot._figure import pyplot
 from ddgjax.verify import check
+from ddgjax.verify.figures import draw_surface
 from energies.area import face_area, harmonic_iteration, interior_residual
 from energies.dirichlet import dirichlet_solve
 
@@ -164,13 +165,7 @@ def draw_surfaces(path, panels, title: str):
     plt = pyplot()
     fig = plt.figure(figsize=(4.0 * len(panels), 4.0))
     for k, (X, G, name) in enumerate(panels):
-        ax = fig.add_subplot(1, len(panels), k + 1, projection="3d")
-        G = np.asarray(G)
-        G = G[(G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 2] != G[:, 0])]
-        ax.plot_trisurf(X[:, 0], X[:, 1], X[:, 2], triangles=G, color="lightsteelblue", edgecolor="k", linewidth=0.4)
-        ax.set_title(name, fontsize=9)
-        ax.set_box_aspect((1, 1, 0.5))
-        ax.set_axis_off()
+        draw_surface(fig.add_subplot(1, len(panels), k + 1, projection="3d"), X, G, name)
     fig.suptitle(title)
     return save_figure(fig, path, dpi=90)
 
