@@ -2,10 +2,12 @@
 
 For each problem, in a fresh process (no compilation cache), the program `solve` compiles is
 lowered again and compiled again, timed apart: lines of its StableHLO text, seconds to lower
-(trace), seconds for XLA to compile, with LLVM's backend optimisation off as in the test suite and
-`verify` (`--opt` keeps XLA's default).  Medians of `--repeats` processes.
+(trace), and seconds for XLA to compile under three settings side by side (`SETTINGS`: XLA's
+defaults as the command line uses them, LLVM's backend optimisation off, and the fast-compile
+flags of the test suite and `verify`), with the ratio fast / defaults.  Medians of `--repeats`
+processes.
 
-    python benchmarks/compile_size.py [--repeats 3] [--opt]
+    python benchmarks/compile_size.py [--repeats 3]
 
 Rows: the clamped elastica (n = 100, KLU), the same at n = 30 on the dense path, the twisted rod
 (n = 50, KLU) and the area of a 12 × 12 saddle grid (N = 300: KLU).  The machine may be shared:
@@ -21,6 +23,8 @@ import statistics
 import subprocess
 import sys
 from pathlib import Path
+
+from ddgjax.compile_cache import fast_compile_xla_flags
 
 HERE = Path(__file__).resolve().parent
 
@@ -68,10 +72,17 @@ print(json.dumps(dict(lines=lowered.as_text().count("\\n"), lower=lower, compile
 PROBLEMS = ("elastica", "elastica-dense", "rod", "area")
 
 
-def measure(name: str, optimise: bool) -> dict:
-    env = dict(os.environ, DDGJAX_COMPILE_CACHE="off")
-    if not optimise:
-        env.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
+SETTINGS = {
+    "defaults": "",
+    "O0": "--xla_backend_optimization_level=0",
+    "fast": fast_compile_xla_flags(),
+}
+"""The XLA flags compared: XLA's defaults (the command line), LLVM's backend optimisation off,
+and `ddgjax.compile_cache.fast_compile_xla_flags()` (the test suite and `verify`'s workers)."""
+
+
+def measure(name: str, xla_flags: str) -> dict:
+    env = dict(os.environ, DDGJAX_COMPILE_CACHE="off", XLA_FLAGS=xla_flags)
     out = subprocess.run([sys.executable, "-c", PROBE.format(here=str(HERE), name=name)], env=env, check=True,
                          capture_output=True, text=True, cwd=HERE.parent).stdout
     return json.loads(out.strip().splitlines()[-1])
@@ -80,13 +91,20 @@ def measure(name: str, optimise: bool) -> dict:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--opt", action="store_true", help="XLA's default backend optimisation")
     args = parser.parse_args(argv)
-    print(f"{'problem':16s} {'HLO lines':>9s} {'lower s':>8s} {'compile s':>9s} {'steps':>5s}")
+    for setting, flags in SETTINGS.items():
+        print(f"{setting:8s} XLA_FLAGS={flags!r}")
+    columns = "".join(f" {'compile ' + k:>16s}" for k in SETTINGS)
+    print(f"{'problem':16s} {'HLO lines':>9s} {'lower s':>8s}{columns} {'fast/defaults':>13s} {'steps':>5s}")
     for name in PROBLEMS:
-        runs = [measure(name, args.opt) for _ in range(args.repeats)]
-        med = {k: statistics.median(r[k] for r in runs) for k in ("lines", "lower", "compile", "steps")}
-        print(f"{name:16s} {med['lines']:9.0f} {med['lower']:8.2f} {med['compile']:9.2f} {med['steps']:5.0f}")
+        med = {}
+        for setting, flags in SETTINGS.items():
+            runs = [measure(name, flags) for _ in range(args.repeats)]
+            med[setting] = {k: statistics.median(r[k] for r in runs) for k in ("lines", "lower", "compile", "steps")}
+        fast = med["fast"]
+        times = "".join(f" {med[k]['compile']:16.2f}" for k in SETTINGS)
+        ratio = fast["compile"] / med["defaults"]["compile"]
+        print(f"{name:16s} {fast['lines']:9.0f} {fast['lower']:8.2f}{times} {ratio:13.2f} {fast['steps']:5.0f}")
     return 0
 
 

@@ -1,8 +1,8 @@
 """Shared test helpers. Importing ddgjax switches JAX to float64.
 
 The tests solve small problems many times over: XLA's compile time, not run time, is most of
-the suite's time, so they run with LLVM's backend optimisation off (about half the compile
-time of a Newton solver; set before JAX starts its backend).  Set XLA_FLAGS to override.
+the suite's time, so they run with `compile_cache.fast_compile_xla_flags()` (about half the
+compile time of a Newton solver; set before JAX starts its backend).  Set XLA_FLAGS to override.
 The compiled programs are kept in the persistent compilation cache of the command line
 (`ddgjax.compile_cache`, the user's cache folder; `DDGJAX_COMPILE_CACHE=DIR` or `=off`): the
 pytest-xdist workers share it, and a second run of the suite loads what the first compiled.
@@ -10,14 +10,13 @@ pytest-xdist workers share it, and a second run of the suite loads what the firs
 
 import os
 
-os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
+from ddgjax import compile_cache  # imports JAX without starting its backend
+
+os.environ.setdefault("XLA_FLAGS", compile_cache.fast_compile_xla_flags())
 
 import jax  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-
-import ddgjax  # noqa: F401, E402
-from ddgjax import compile_cache  # noqa: E402
 
 compile_cache.enable()
 

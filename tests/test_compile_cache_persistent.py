@@ -112,3 +112,13 @@ def test_a_program_with_a_host_callback_compiles_in_every_process(tmp_path):
     cache_events(HOST_CALLBACK, tmp_path)
     second = cache_events(HOST_CALLBACK, tmp_path)
     assert second["misses"] == 0 and second["compiles"] == 1
+
+
+@pytest.mark.parametrize("version, emitters_flag", [("0.10.2", True), ("0.10.0rc1", True), ("0.9.9", False),
+                                                    ("0.11.0", False), ("1.0", False)])
+def test_fast_compile_flags_pass_the_emitter_flag_only_to_jaxlibs_known_to_accept_it(version, emitters_flag):
+    """XLA aborts the process on an unknown flag: the flag goes only to the tested jaxlib range."""
+    flags = compile_cache.fast_compile_xla_flags(version).split()
+    assert "--xla_backend_optimization_level=0" in flags
+    assert ("--xla_cpu_use_fusion_emitters=false" in flags) is emitters_flag
+

@@ -12,6 +12,7 @@ from pathlib import Path
 from queue import Empty
 from typing import Iterable
 
+from .. import compile_cache
 from ..errors import InvalidInputError
 from ._registry import Check, Outcome, one_line, registry, run_check
 from ._report import write_report
@@ -121,9 +122,9 @@ def _workers(jobs: int):
     from concurrent.futures import ProcessPoolExecutor
 
     # The checks solve small problems once each: XLA's compile time, not their run time, is
-    # most of a run, and LLVM's backend optimisation off halves it.  Spawned workers start a
-    # fresh JAX backend, so the setting applies there (unless XLA_FLAGS is set already).
-    os.environ.setdefault("XLA_FLAGS", "--xla_backend_optimization_level=0")
+    # most of a run.  Spawned workers start a fresh JAX backend, so the fast-compile flags apply
+    # there (unless XLA_FLAGS is set already).
+    os.environ.setdefault("XLA_FLAGS", compile_cache.fast_compile_xla_flags())
     context = multiprocessing.get_context("spawn")
     with context.Manager() as manager:
         pool = ProcessPoolExecutor(jobs, mp_context=context)
