@@ -88,7 +88,20 @@ def _integrate(Phi0, M0, a, alpha, length, ts):
     return sol.ys
 
 
-_sample = jax.jit(_integrate)
+_integrate_jit = jax.jit(_integrate)
+
+SAMPLE_BUCKET = 64
+"""Arc lengths are integrated in blocks of this many (the last one repeated), so that sampling
+at m points compiles one program per ⌈m / 64⌉ rather than one per m."""
+
+
+def _sample(rod: SmoothRod, s) -> tuple:
+    """(Φ, M, γ) of the top motion of `rod` at the arc lengths s (m,)."""
+    s = jnp.asarray(s, dtype=float)
+    m = s.shape[0]
+    padded = jnp.concatenate([s, jnp.full((-m % SAMPLE_BUCKET,), s[-1])]) if m else s
+    ys = _integrate_jit(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length), padded)
+    return tuple(y[:m] for y in ys)
 
 
 def shoot(z: Float[Array, "6"], Phi0, Phi1, chord, alpha, length) -> Float[Array, "6"]:
@@ -174,8 +187,7 @@ def discrete_errors(problem, solution, smooth: SmoothRod) -> dict[str, float]:
 
 def sample(rod: SmoothRod, s) -> tuple[Float[Array, "m 4"], Float[Array, "m 3"]]:
     """The frames Φ(s) and the centreline γ(s) (γ(0) = 0) at the arc lengths s (m,)."""
-    Phi, _M, gamma = _sample(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length),
-                             jnp.asarray(s, dtype=float))
+    Phi, _M, gamma = _sample(rod, s)
     return Phi, gamma
 
 
@@ -217,8 +229,7 @@ def jet(rod: SmoothRod, s) -> RodJet:
     top's vector field by forward-mode autodiff (nothing typed in by hand).  Φ is normalised
     first: the integrator leaves H_1 by its tolerance, which the polynomial extension of the
     potential would turn into an O(|a| · tolerance) error of ω'."""
-    Phi, M, gamma = _sample(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length),
-                            jnp.asarray(s, dtype=float))
+    Phi, M, gamma = _sample(rod, s)
     return RodJet(gamma, *_jet(Phi, M, jnp.asarray(rod.alpha), jnp.asarray(rod.a, dtype=float)))
 
 
