@@ -177,3 +177,43 @@ def test_invalid_parameters_raise(kwargs, match):
 def test_elliptic_e_rejects_m_above_one():
     with pytest.raises(InvalidInputError, match="m = k"):
         elliptic_e(1.0, 1.2)
+
+
+# --- non-planar elastica (ddgjax.smooth.space_elastica) ------------------------------------------
+
+
+def test_space_elastica_reduces_to_the_exact_planar_one():
+    """Started from the planar curve's T(0), T'(0) and load, the integrated pendulum is the
+    elliptic elastica (an independent oracle for the integrator) to 1e-10."""
+    from ddgjax.smooth.space_elastica import space_elastica
+
+    planar = inflectional(0.7, lam=1.3, u0=0.4, length=3.0, load_angle=0.7)
+    dT0 = planar.curvature(0.0) * planar.normal(0.0)  # T' = κN
+    curve = space_elastica(planar.tangent(0.0), dT0, planar.a, length=planar.length)
+    s = np.linspace(0.0, planar.length, 101)
+    assert np.max(np.abs(curve.gamma(s) - (planar.gamma(s) - planar.gamma(0.0)))) <= 1e-10
+    assert curve.spans_space() <= 1e-10  # planar: the negative case of Remark 3.2's span
+
+
+def test_space_elastica_is_non_planar_and_unit_speed():
+    from ddgjax.smooth.space_elastica import space_elastica
+
+    curve = space_elastica([1.0, 0, 0], [0.0, 2.0, 1.5], [3.0, -4.0, 2.0])
+    s = np.linspace(0.0, 1.0, 65)
+    T = curve.state(s)[:, 3:6]
+    assert np.max(np.abs(np.linalg.norm(T, axis=1) - 1)) <= 1e-11
+    assert curve.spans_space() >= 0.1
+
+
+@pytest.mark.parametrize("args, match", [
+    (([1.0, 0, 0.1], [0, 1.0, 0], [0, 0, 1.0]), "unit vector"),
+    (([1.0, 0, 0], [0.5, 1.0, 0], [0, 0, 1.0]), "orthogonal"),
+    (([1.0, 0, 0], [0, 1.0, 0], [0, 0, np.nan]), "finite"),
+])
+def test_space_elastica_rejects_invalid_data(args, match):
+    from ddgjax.smooth.space_elastica import space_elastica
+
+    with pytest.raises(InvalidInputError, match=match):
+        space_elastica(*args)
+    with pytest.raises(InvalidInputError, match="positive length"):
+        space_elastica([1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], length=0.0)

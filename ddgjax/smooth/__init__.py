@@ -5,7 +5,9 @@
   curve with exact curvature (Ex 2.2, Ex 2.3);
 - `top`: the Lagrange top, its action (3.10) and equations of motion by autodiff (Sec 3.4.1);
 - `kirchhoff`: smooth clamped rods by shooting with the top (Thm 3.11, 3.13); imported on first
-  use (it loads diffrax and optimistix).
+  use (it loads diffrax and optimistix);
+- `space_elastica`: non-planar elastic curves, the tangent a spherical pendulum integrated by
+  scipy (Thm 3.1, 3.2); imported on first use.
 
 Nothing here uses a discrete energy of `energies/`: these are independent computations.
 """
@@ -18,6 +20,6 @@ from . import top as top
 
 
 def __getattr__(name: str):
-    if name == "kirchhoff":
-        return _importlib.import_module(".kirchhoff", __name__)
+    if name in ("kirchhoff", "space_elastica"):
+        return _importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

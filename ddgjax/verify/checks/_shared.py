@@ -45,9 +45,10 @@ def smooth_clamped_elastica() -> exact.PlanarElastica:
     return exact.inflectional(0.8, lam=4.0, u0=0.3, length=1.0)
 
 
-def edge_midpoint_tangents(curve: exact.PlanarElastica, n: int) -> np.ndarray:
-    """Unit tangents of `curve` at the n edge midpoints of a uniform partition of [0, L]: a start
-    for Newton within O(h²) of the discrete elastica."""
+def edge_midpoint_tangents(curve, n: int) -> np.ndarray:
+    """Unit tangents of the smooth elastica `curve` (planar or in space: its `tangent(s)` and
+    `length`) at the n edge midpoints of a uniform partition of [0, L]: a start for Newton
+    within O(h²) of the discrete elastica."""
     return curve.tangent((np.arange(n) + 0.5) * curve.length / n)
 
 

@@ -11,6 +11,7 @@ import numpy as np
 import ddgjax as dg
 from ddgjax.problem import constraint_values
 from ddgjax.smooth import elastica as exact
+from ddgjax.smooth import space_elastica as smooth_space
 from ddgjax.verify import check
 from energies import elastica
 from solvers import solve
@@ -198,10 +199,20 @@ def regular_polygon_energy(ctx, n):
 
 
 @functools.cache
-def _limit_tables(clamp: str, ns: tuple):
-    """Max vertex distance to the exact clamped elastica and |λ − a| at each n (Newton started
-    from the exact tangents at the edge midpoints)."""
-    smooth = smooth_clamped_elastica()
+def smooth_space_curve() -> smooth_space.SpaceElastica:
+    """A non-planar elastic curve (Thm 3.1): the spherical pendulum from T(0) = e1,
+    T'(0) = (0, 2, 1.5) under the load a = (3, −4, 2), L = 1."""
+    return smooth_space.space_elastica([1.0, 0.0, 0.0], [0.0, 2.0, 1.5], [3.0, -4.0, 2.0])
+
+
+REFERENCES = {"planar": smooth_clamped_elastica, "space": smooth_space_curve}
+
+
+@functools.cache
+def _limit_tables(clamp: str, ns: tuple, reference: str = "planar"):
+    """Max vertex distance to the smooth clamped elastica `REFERENCES[reference]` and |λ − a| at
+    each n (Newton started from the smooth tangents at the edge midpoints)."""
+    smooth = REFERENCES[reference]()
     data = smooth.boundary_data()
     curve_errors, load_errors = [], []
     for n in ns:
@@ -211,8 +222,9 @@ def _limit_tables(clamp: str, ns: tuple):
         gamma = np.asarray(elastica.curve(sol.x, problem, start=data.start))
         curve_errors.append(np.max(np.linalg.norm(gamma - smooth.gamma(np.arange(n + 1) / n), axis=1)))
         load_errors.append(np.linalg.norm(np.asarray(elastica.load(sol)) - smooth.a))
-    return (dg.limits.ConvergenceTable.from_errors(ns, curve_errors, f"max_j dist(γ_j, γ(s_j)), clamp={clamp}"),
-            dg.limits.ConvergenceTable.from_errors(ns, load_errors, f"dist(λ, a), clamp={clamp}"))
+    label = f"clamp={clamp}, {reference} elastica"
+    return (dg.limits.ConvergenceTable.from_errors(ns, curve_errors, f"max_j dist(γ_j, γ(s_j)), {label}"),
+            dg.limits.ConvergenceTable.from_errors(ns, load_errors, f"dist(λ, a), {label}"))
 
 
 QUICK_NS, FULL_NS = (16, 32, 64), (16, 32, 64, 128, 256, 512, 1024)  # quick: n = 32 is compiled for Thm 3.8
@@ -237,3 +249,54 @@ def elastica_load_limit(ctx, ns):
 def elastica_edge_clamp_limit(ctx, ns):
     curve_table, _ = _limit_tables("edge", ns)
     return ctx.convergence(curve_table, "convergence_elastica_edge_clamp").fitted_order
+
+
+# --- non-planar elastica (Thm 3.1, 3.2 in space) ------------------------------------------------
+
+
+def _non_planar(curve) -> smooth_space.SpaceElastica:
+    if curve.spans_space() < 0.1:
+        raise AssertionError(f"|det(chord, T(0), T(L))| = {curve.spans_space():.2e}: the reference is planar")
+    return curve
+
+
+def _b_spread(curve: smooth_space.SpaceElastica, a, samples: int) -> float:
+    """max_s |b(s) − b(0)| for `b = γ'' × γ' − a × γ` along `curve` (Thm 3.2: constant iff elastic
+    with load a)."""
+    y = curve.state(np.linspace(0.0, curve.length, samples))
+    gamma, T, dT = y[:, 0:3], y[:, 3:6], y[:, 6:9]
+    b = np.cross(dT, T) - np.cross(a, gamma)
+    return float(np.max(np.abs(b - b[0])))
+
+
+@check("Thm 3.1, 3.2", "the non-planar smooth reference (the tangent a spherical pendulum, T'' = cT + a, integrated) "
+       "satisfies the first form of Thm 3.2: b = γ'' × γ' − a × γ is constant",
+       quantity="max_s |b(s) − b(0)| (257 samples)", at_most=1e-10, quick=dict(samples=257))
+def space_elastica_euler_lagrange(ctx, samples):
+    curve = _non_planar(smooth_space_curve())
+    return _b_spread(curve, curve.a, samples)
+
+
+@check("Thm 3.2", "negative control: with −a in place of the pendulum's gravity, b = γ'' × γ' − a × γ varies",
+       quantity="max_s |b(s) − b(0)| with −a", at_least=1e-3, quick=dict(samples=257))
+def space_elastica_wrong_load_fails(ctx, samples):
+    curve = smooth_space_curve()
+    return _b_spread(curve, -curve.a, samples)
+
+
+@check("Thm 3.1, 3.2", "clamped discrete elastica (vertex clamp) converge to a non-planar smooth elastic curve "
+       "(|det(chord, T(0), T(L))| ≈ 0.49), order 2",
+       quantity="fitted order of max_j |γ_j − γ(s_j)|", target=2.0, within=0.2, quick=dict(ns=QUICK_NS),
+       full=dict(ns=FULL_NS))
+def elastica_space_limit(ctx, ns):
+    _non_planar(smooth_space_curve())
+    curve_table, _ = _limit_tables("vertex", ns, "space")
+    return ctx.convergence(curve_table, "convergence_space_elastica").fitted_order
+
+
+@check("Thm 3.1, 3.2", "on the non-planar elastica the chord multipliers λ converge to the pendulum's gravity a, "
+       "order 2", quantity="fitted order of |λ − a|", target=2.0, within=0.2, quick=dict(ns=QUICK_NS),
+       full=dict(ns=FULL_NS))
+def elastica_space_load_limit(ctx, ns):
+    _, load_table = _limit_tables("vertex", ns, "space")
+    return ctx.convergence(load_table, "convergence_space_elastica_load").fitted_order
