@@ -4,7 +4,7 @@ The smooth reference is independent of the discrete energy: the clamped rod of T
 computed as a motion of the Lagrange top (Kirchhoff analogy, Thm 3.11) by shooting
 (`ddgjax.kirchhoff`); the discrete rod only supplies the starting guess.  The quick limits
 (Thm 3.11, 3.13 and the coefficient c of Def 3.7, at n = 8, 16, 32, with a negative control)
-are checks of `ddgjax verify` (`sec3_rods`), which `tests/test_verify_checks.py` runs.
+are checks of `ddgjax verify` (`sec3_rod_limits`), which `tests/test_verify_checks.py` runs.
 """
 
 import jax.numpy as jnp
