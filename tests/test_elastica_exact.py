@@ -217,3 +217,14 @@ def test_space_elastica_rejects_invalid_data(args, match):
         space_elastica(*args)
     with pytest.raises(InvalidInputError, match="positive length"):
         space_elastica([1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], length=0.0)
+
+
+def test_space_elastica_is_not_evaluated_outside_its_arc():
+    """The dense output would extrapolate silently: an arc length outside [0, L] (or NaN) raises."""
+    from ddgjax.smooth.space_elastica import space_elastica
+
+    curve = space_elastica([1.0, 0, 0], [0.0, 2.0, 1.5], [3.0, -4.0, 2.0])
+    for s in (1.5, -0.1, np.nan):
+        with pytest.raises(InvalidInputError, match="outside"):
+            curve.gamma(np.array([0.5, s]))
+    assert curve.gamma(1.0).shape == (3,) and curve.tangent(np.array([0.0, 1.0])).shape == (2, 3)

@@ -48,8 +48,13 @@ class SpaceElastica:
     dense: object  # scipy's OdeSolution of (γ, T, T')
 
     def state(self, s) -> np.ndarray:
-        """`(γ, T, T')` at the arc lengths s: shape `(..., 9)`."""
-        return np.moveaxis(self.dense(np.asarray(s, dtype=float)), 0, -1)
+        """`(γ, T, T')` at the arc lengths s: shape `(..., 9)`.  **Raises:** `InvalidInputError`
+        for an arc length outside [0, length] (the dense output would extrapolate)."""
+        s = np.asarray(s, dtype=float)
+        outside = ~((s >= 0.0) & (s <= self.length))
+        if np.any(outside):
+            raise InvalidInputError(f"arc length {s[outside].flat[0]!r} is outside [0, {self.length!r}]")
+        return np.moveaxis(self.dense(s), 0, -1)
 
     def gamma(self, s) -> np.ndarray:
         return self.state(s)[..., 0:3]
