@@ -139,7 +139,7 @@ def _smooth_jet(shot_from: int | None, samples: int):
     return smooth, kirchhoff.jet(smooth, jnp.linspace(0.0, smooth.length, samples))
 
 
-SMOOTH_QUICK, SMOOTH_FULL = dict(shot_from=None, samples=65), dict(shot_from=64, samples=257)
+SMOOTH_QUICK, SMOOTH_FULL = dict(shot_from=None, samples=64), dict(shot_from=64, samples=256)  # multiples of kirchhoff.SAMPLE_BUCKET
 
 
 @check("Thm 3.13", "along a smooth rod (a Lagrange top motion; in the full run the rod shot to the clamps) τ is "
