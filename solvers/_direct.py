@@ -39,9 +39,8 @@ area Hessian of a 180² grid Pardiso factorises in 0.6× the time scipy's `splu`
   inertia unknown; also the complex solves of the Levenberg–Marquardt fallback without Pardiso.
 
 The Levenberg–Marquardt fallback's `(K + i√ν I)⁻¹` is, with Pardiso, one real symmetric
-factorisation of `[[K, √ν I], [√ν I, −K]]` with weighted matching (`_solve_shifted_real`); a
-complex SuperLU factorisation of K + i√ν I took 73 s and several GB on the 98,306-vertex bubble
-(`benchmarks/surfaces.py`), against a Newton step's 1.4 s.
+factorisation of `[[K, √ν I], [√ν I, −K]]` of twice the size with weighted matching
+(`_solve_shifted_real`), not a complex factorisation of K + i√ν I.
 """
 
 from __future__ import annotations

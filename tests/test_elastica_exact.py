@@ -205,18 +205,17 @@ def test_space_elastica_is_non_planar_and_unit_speed():
     assert curve.spans_space() >= 0.1
 
 
-@pytest.mark.parametrize("args, match", [
-    (([1.0, 0, 0.1], [0, 1.0, 0], [0, 0, 1.0]), "unit vector"),
-    (([1.0, 0, 0], [0.5, 1.0, 0], [0, 0, 1.0]), "orthogonal"),
-    (([1.0, 0, 0], [0, 1.0, 0], [0, 0, np.nan]), "finite"),
+@pytest.mark.parametrize("args, length, match", [
+    (([1.0, 0, 0.1], [0, 1.0, 0], [0, 0, 1.0]), 1.0, "unit vector"),
+    (([1.0, 0, 0], [0.5, 1.0, 0], [0, 0, 1.0]), 1.0, "orthogonal"),
+    (([1.0, 0, 0], [0, 1.0, 0], [0, 0, np.nan]), 1.0, "finite"),
+    (([1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]), 0.0, "positive length"),
 ])
-def test_space_elastica_rejects_invalid_data(args, match):
+def test_space_elastica_rejects_invalid_data(args, length, match):
     from ddgjax.smooth.space_elastica import space_elastica
 
     with pytest.raises(InvalidInputError, match=match):
-        space_elastica(*args)
-    with pytest.raises(InvalidInputError, match="positive length"):
-        space_elastica([1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], length=0.0)
+        space_elastica(*args, length=length)
 
 
 def test_space_elastica_is_not_evaluated_outside_its_arc():

@@ -66,10 +66,10 @@ def rod_and_limit(n: int, shot_from: int | None):
     def unit(q):
         return q / jnp.linalg.norm(q, axis=-1, keepdims=True)
 
-    ends, gamma = kirchhoff.sample(smooth, jnp.array([0.0, smooth.length]))
-    midpoints, _ = kirchhoff.sample(smooth, (jnp.arange(n) + 0.5) * smooth.length / n)
-    problem = rod.clamped(n, alpha=smooth.alpha, length=smooth.length, chord=gamma[1], frame_start=unit(ends[0]),
-                          frame_end=unit(ends[1]), clamp="vertex", x0=unit(midpoints))
+    s = jnp.concatenate([jnp.array([0.0]), (jnp.arange(n) + 0.5) / n, jnp.array([1.0])]) * smooth.length
+    Phi, gamma = kirchhoff.sample(smooth, s)  # the start, the edge midpoints, the end
+    problem = rod.clamped(n, alpha=smooth.alpha, length=smooth.length, chord=gamma[-1], frame_start=unit(Phi[0]),
+                          frame_end=unit(Phi[-1]), clamp="vertex", x0=unit(Phi[1:-1]))
     return problem, solve(problem), smooth
 
 
