@@ -69,3 +69,13 @@ def test_smooth_limit_tables_edge_and_vertex_clamps(smooth):
         table = dg.limits.convergence(lambda n: kirchhoff.discrete_errors(*_discrete(n, clamp), smooth)["position"], ns)
         print(clamp, table.to_markdown())
         assert abs(table.fitted_order - order) <= 0.3, table.to_markdown()
+
+
+def test_sampling_a_smooth_rod_at_decreasing_arc_lengths_is_an_input_error():
+    """The integrator saves along increasing s only: a decrease is named, not a raw runtime error."""
+    from ddgjax.errors import InvalidInputError
+
+    rod_ = kirchhoff.SmoothRod(jnp.array([1.0, 0, 0, 0]), jnp.array([2.4, 3.0, -1.0]), jnp.array([16.2, 15.9, 1.0]),
+                               0.6, 1.0)
+    with pytest.raises(InvalidInputError, match=r"s\[2\] = 0.1"):
+        kirchhoff.sample(rod_, jnp.array([0.0, 0.5, 0.1]))

@@ -96,9 +96,16 @@ at m points compiles one program per ⌈m / 64⌉ rather than one per m."""
 
 
 def _sample(rod: SmoothRod, s) -> tuple:
-    """(Φ, M, γ) of the top motion of `rod` at the arc lengths s (m,)."""
+    """(Φ, M, γ) of the top motion of `rod` at the arc lengths s (m,), non-decreasing.
+
+    **Raises:** `InvalidInputError` for concrete arc lengths that decrease somewhere (the
+    integrator saves along one direction of s only)."""
     s = jnp.asarray(s, dtype=float)
     m = s.shape[0]
+    if not isinstance(s, jax.core.Tracer) and m > 1 and bool(jnp.any(jnp.diff(s) < 0)):
+        k = int(jnp.argmax(jnp.diff(s) < 0))
+        raise InvalidInputError(f"arc lengths must be non-decreasing: s[{k + 1}] = {float(s[k + 1])!r} < s[{k}] = "
+                                f"{float(s[k])!r}")
     padded = jnp.concatenate([s, jnp.full((-m % SAMPLE_BUCKET,), s[-1])]) if m else s
     ys = _integrate_jit(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length), padded)
     return tuple(y[:m] for y in ys)
