@@ -22,7 +22,7 @@ import numpy as np
 from jax.flatten_util import ravel_pytree
 from jaxtyping import Array, Float
 
-from ._checks import check_finite, check_same_structure, is_concrete
+from ._checks import check_finite, check_positive, check_same_structure, checked_count, is_concrete
 from ._flat import layout_of
 from .errors import ConvergenceError, InvalidInputError, ShapeError
 from .problem import Problem, constraint_values
@@ -37,12 +37,14 @@ def gradient_flow(problem: Problem) -> Callable:
     entries; along it the energy decreases, `dE/dt = −|f|²`.  Uses `problem.params`.
 
     **Raises** (when `f` is called): `ShapeError` unless `x` has the structure and shapes of
-    `problem.x0` (naming the leaf, the expected and the given shape).
+    `problem.x0` (naming the leaf, the expected and the given shape); `NonFiniteError` for a
+    concrete `x` with NaN or inf (naming the entry).
     """
     layout = layout_of(problem)
 
     def f(x):
         check_same_structure(problem.x0, x, "x", "problem.x0")
+        check_finite(x, "x")
         z = layout.ravel(x)
         u = z[layout.free]
 
@@ -187,11 +189,15 @@ def integrate(
     - `constraints(x) -> 1-D`: keep the iterates on `{constraints = 0}` by projecting after
       every step (every saved time for `"dopri8"`).
 
-    **Raises:** `NonFiniteError` for NaN in `x0`, `ShapeError` unless `f(x0)` has the structure
-    and shapes of `x0` (naming the expected and the given shape), `InvalidInputError` for bad
-    options.
+    **Raises:** `NonFiniteError` for NaN in `x0` or a `t1` that is not finite, `ShapeError`
+    unless `f(x0)` has the structure and shapes of `x0` (naming the expected and the given
+    shape), `InvalidInputError` for bad options (`rtol` not finite and positive, `saves` < 2, an
+    unknown `method`).
     """
     check_finite(x0, "x0")
+    check_finite(t1, "t1")
+    check_positive(rtol, "rtol")
+    saves = checked_count(saves, 2, "saves (the number of saved times, t = 0 and t1 included)")
     check_same_structure(x0, jax.eval_shape(f, x0), "f(x0)", "x0")
     method = method or ("gauss6" if steps is not None else "dopri8")
     if method not in METHODS:

@@ -217,6 +217,7 @@ def from_axis_angle(axis: Vector, angle) -> Quaternion:
         zero = np.all(np.asarray(axis) == 0, axis=-1)
         if np.any(zero):
             raise InvalidInputError(f"axis is the zero vector at index {_first_bad(np.atleast_1d(zero))}: no rotation axis")
+    check_finite(angle, "angle")
     half = 0.5 * jnp.asarray(angle, dtype=float)[..., None]
     imag = jnp.sin(half) * (axis / _safe_norm(axis))
     real = jnp.broadcast_to(jnp.cos(half), imag.shape[:-1] + (1,))

@@ -58,6 +58,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
+from ddgjax._checks import check_finite, check_positive
 from ddgjax.errors import InvalidInputError, MeshError
 from ddgjax.laplace import check_nondegenerate, checked_triangle_mesh
 from ddgjax.mesh import boundary_vertices
@@ -196,9 +197,16 @@ def helfrich(V, F, *, kappa: float = 1.0, H0: float = 0.0, area: float | None = 
 
     **Raises:** `NonFiniteError`, `MeshError` / `NonManifoldError` (as `area.simplicial`),
     `DegenerateFaceError` (a zero-area face), `InvalidInputError` (a boundary: the surface must be
-    closed), `OrientationError` (faces not consistently oriented).
+    closed; `kappa` or `area` not finite and positive), `OrientationError` (faces not
+    consistently oriented).
     """
     V, F = _closed(V, F)
+    check_positive(kappa, "kappa, the bending rigidity,")
+    check_finite(H0, "H0")
+    if area is not None:
+        check_positive(area, "area, the prescribed surface area,")
+    if volume is not None:
+        check_finite(volume, "volume")
     stencil, data = star_stencil(F, len(V))
     params = {"kappa": float(kappa), "H0": float(H0)}
     named = {}

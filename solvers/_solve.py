@@ -8,7 +8,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ddgjax._checks import check_positive, is_concrete
+from ddgjax._checks import check_positive, checked_count, is_concrete
 from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError
 from ddgjax.problem import Problem, flatten_multipliers
 
@@ -242,8 +242,7 @@ def solve(
     if warm_start not in WARM_STARTS:
         raise InvalidInputError(f"warm_start must be one of {WARM_STARTS}, got {warm_start!r}")
     check_positive(tol, "tol")
-    if int(max_steps) < 0:
-        raise InvalidInputError(f"max_steps must be >= 0, got {max_steps}")
+    max_steps = checked_count(max_steps, 0, "max_steps")
     lam0 = None if multipliers0 is None else flatten_multipliers(problem, multipliers0)
     spec = spec_of(problem)
     if spec.n == 0:

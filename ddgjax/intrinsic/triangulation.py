@@ -46,6 +46,7 @@ from ..mesh.connectivity import (
 from ..mesh.lengths import angle_defects as angle_defects_of_sides
 from ..mesh.lengths import (
     check_edge_lengths,
+    check_positions,
     corner_angles_of_sides,
     normalised,
     side_cotangents,
@@ -189,11 +190,7 @@ def normalised_side_lengths(tri: Triangulation) -> np.ndarray:
 def checked_positions(V) -> np.ndarray:
     """V as an (nv, n) float64 array; `NonFiniteError` naming the first vertex with NaN / inf."""
     V = np.asarray(V, dtype=np.float64)
-    if V.ndim != 2:
-        raise ShapeError(f"V must be an (nv, n) array of positions, got shape {V.shape}")
-    bad = np.argwhere(~np.isfinite(V))
-    if bad.size:
-        raise NonFiniteError(f"V has the non-finite value {V[tuple(bad[0])]} at vertex {bad[0, 0]}")
+    check_positions(V, dims=None)
     return V
 
 

@@ -168,7 +168,7 @@ def faces_as_corners(F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     `F` is an (nf, k) integer array (vectorised) or a sequence of polygons (vertex index lists of
     any lengths ≥ 2).  Raises `ShapeError` for a face with fewer than two corners and `MeshError`
-    for a non-integer or negative index (naming the face).
+    for indices that are not numbers, a non-integer or negative index (naming the face).
     """
     if isinstance(F, np.ndarray) or (hasattr(F, "shape") and hasattr(F, "dtype")):
         arr = np.asarray(F)
@@ -184,6 +184,8 @@ def faces_as_corners(F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if short.size:
             raise ShapeError(f"face {short[0]} has {sizes[short[0]]} corners; a face needs at least 2")
         flat = np.concatenate(polys) if polys else np.zeros(0, np.int64)
+    if flat.size and not (np.issubdtype(flat.dtype, np.number) or flat.dtype == bool):
+        raise MeshError(f"F must hold integer vertex indices, got values of type {flat.dtype} (face 0: {flat[:3].tolist()})")
     if flat.size and not np.issubdtype(flat.dtype, np.integer):
         if not np.all(flat == np.round(flat)):
             bad = int(np.argmax(flat != np.round(flat)))
@@ -197,6 +199,23 @@ def faces_as_corners(F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if vertex.size and vertex.min() < 0:
         bad = int(np.argmin(vertex))
         raise MeshError(f"face {face[bad]} has the negative vertex index {vertex[bad]}")
+    return vertex, face, nxt
+
+
+def checked_corners(F, n_vertices: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`faces_as_corners(F)` of at least one polygon, each with at least three corners, labels
+    of vertices `0 … n_vertices − 1` and no repeated vertex.  **Raises:** as `faces_as_corners`
+    and `check_has_faces`; `ShapeError` for a face with two corners, `MeshError` naming the face
+    with an index ≥ `n_vertices` or a repeated vertex."""
+    vertex, face, nxt = faces_as_corners(F)
+    sizes = np.bincount(face)
+    check_has_faces(sizes.size)
+    if sizes.min() < 3:
+        raise ShapeError(f"face {int(np.argmin(sizes))} has {sizes.min()} corners; a polygon needs at least 3")
+    if vertex.size and vertex.max() >= n_vertices:
+        bad = int(np.argmax(vertex))
+        raise MeshError(f"face {face[bad]} has the vertex index {vertex[bad]} >= n_vertices = {n_vertices}")
+    _check_repeated_vertices(vertex, face)
     return vertex, face, nxt
 
 
@@ -335,6 +354,8 @@ def checked_triangles(F, n_vertices: int | None = None) -> tuple[np.ndarray, int
     if F.ndim != 2 or F.shape[1] != 3:
         raise ShapeError(f"F must be an (nf, 3) array of triangles, got shape {F.shape}")
     check_has_faces(F.shape[0])
+    if not (np.issubdtype(F.dtype, np.number) or F.dtype == bool):
+        raise MeshError(f"F must hold integer vertex indices, got values of type {F.dtype} (face 0: {F[0].tolist()})")
     if F.size and not np.issubdtype(F.dtype, np.integer) and not np.all(F == np.round(F)):
         f = int(np.argwhere(F != np.round(F))[0, 0])
         raise MeshError(f"face {f} has a non-integer vertex index {F[f].tolist()}")

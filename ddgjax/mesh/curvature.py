@@ -29,7 +29,8 @@ import numpy as np
 
 from .._checks import check_finite, check_positive, is_concrete
 from ..errors import MeshError, OrientationError, ShapeError, SingularVertexError
-from .connectivity import Halfedges, check_has_faces, faces_as_corners, from_faces
+from .connectivity import Halfedges, check_has_faces, checked_corners, faces_as_corners, from_faces
+from .lengths import check_positions
 from .lengths import (
     check_face_areas,
     defect_from_angles,
@@ -66,9 +67,7 @@ def _corners(F):
 
 def _check_positions(V) -> None:
     """Shape (nv, 3), and finite coordinates when V is concrete (`NonFiniteError`)."""
-    if len(jnp.shape(V)) != 2 or jnp.shape(V)[1] != 3:
-        raise ShapeError(f"V must have shape (nv, 3), got {jnp.shape(V)}")
-    check_finite(V, "V")
+    check_positions(V, dims=(3,))
 
 
 def _validate(V, F):
@@ -218,7 +217,8 @@ def face_area_vectors(V, F):
     face and its direction the normal given by the face's orientation.  Computed on V / s and
     scaled back by s² (module docstring).
 
-    **Raises:** `ShapeError`, `NonFiniteError` (coordinates); `InvalidInputError` where an entry
+    **Raises:** `ShapeError`, `NonFiniteError` (coordinates); `MeshError` (a face with an index
+    that is not a vertex of V, or repeating a vertex, named); `InvalidInputError` where an entry
     is not a float64 at this scale (`lengths.scaled_back`).
     """
     _check_positions(V)
@@ -227,7 +227,11 @@ def face_area_vectors(V, F):
 
 
 def _normalised_area_vectors(V, F):
-    """`(N, s)`: the area vectors of the faces of V / s, s = `lengths.normalised(V)[1]`."""
+    """`(N, s)`: the area vectors of the faces of V / s, s = `lengths.normalised(V)[1]`; a
+    concrete F is checked first (`connectivity.checked_corners`: indices of vertices of V, no
+    repeated vertex in a face)."""
+    if is_concrete(F):
+        checked_corners(np.asarray(F) if hasattr(F, "shape") else F, jnp.shape(V)[0])
     V, s = normalised(jnp.asarray(V))
     vertex, nxt, _ = _corners(F)
     face = np.repeat(np.arange(jnp.shape(F)[0]), jnp.shape(F)[1]) if hasattr(F, "shape") else faces_as_corners(F)[1]

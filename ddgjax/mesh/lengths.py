@@ -28,7 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from .._checks import is_concrete
+from .._checks import concrete_value, is_concrete
 from ..errors import (
     DegenerateFaceError,
     InvalidInputError,
@@ -36,7 +36,7 @@ from ..errors import (
     ShapeError,
     TriangleInequalityError,
 )
-from .connectivity import from_faces
+from .connectivity import check_has_faces, from_faces
 
 __all__ = [
     "DEGENERATE",
@@ -377,13 +377,33 @@ def squared_side_lengths(P):
     return xp.sum(D * D, axis=-1)
 
 
+def check_positions(V, dims: tuple | None = (2, 3)) -> None:
+    """Vertex positions: shape (nv, d) with d in `dims` (any d ≥ 1 for None; `ShapeError`), and
+    finite coordinates when V is concrete (`NonFiniteError`, naming the vertex)."""
+    shape = jnp.shape(V)
+    if len(shape) != 2 or (shape[1] not in dims if dims else shape[1] < 1):
+        want = " or ".join(f"(nv, {d})" for d in dims) if dims else "(nv, d)"
+        raise ShapeError(f"V must be an array of positions of shape {want}, got {shape}")
+    value = concrete_value(V)
+    if value is not None:
+        bad = np.argwhere(~np.isfinite(np.asarray(value, dtype=float)))
+        if bad.size:
+            index = tuple(int(i) for i in bad[0])
+            raise NonFiniteError(f"V has the non-finite value {value[index]} at vertex {index[0]} (index {index})")
+
+
 def edge_lengths(V, F):
     """l(e) = |v_j − v_i| for each edge (i, j) of `ddgjax.mesh.edges(F)`, (ne,); computed on
     V / s (`normalised`) and multiplied by s, so that |v_j − v_i|² need not be a float.
 
-    **Raises:** `InvalidInputError` if a length overflows float64 (`scaled_back`).
+    **Raises:** `ShapeError` (V not (nv, 3) or (nv, 2)), `NonFiniteError` (a coordinate),
+    the errors of `connectivity.from_faces`; `InvalidInputError` if a length overflows float64
+    (`scaled_back`).
     """
-    E = from_faces(np.asarray(F), n_vertices=jnp.shape(V)[0]).edges
+    check_positions(V)
+    h = from_faces(np.asarray(F), n_vertices=jnp.shape(V)[0])
+    check_has_faces(h.n_faces)
+    E = h.edges
     lengths, s = _lengths(jnp.asarray(V), E)
     return scaled_back(lengths, s, 1, "an edge length")
 

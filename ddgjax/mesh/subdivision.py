@@ -37,6 +37,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .._checks import check_finite
 from ..errors import InvalidInputError, ShapeError
 from .connectivity import checked_triangles, from_faces
 
@@ -162,12 +163,14 @@ def subdivide(V, F, *, scheme: str = "midpoint", boundary: str = "curve") -> tup
 
     **Returns:** V' (nv + ne, d) float64, F' (4 nf, 3) int64.
 
-    **Raises:** `ShapeError` (V not 2-D), the errors of `subdivision_matrix`.
+    **Raises:** `ShapeError` (V not 2-D), `NonFiniteError` (a NaN or inf entry of V, named), the
+    errors of `subdivision_matrix`.
     """
     _check_options(scheme, boundary)
     V = np.asarray(V, dtype=np.float64)
     if V.ndim != 2:
         raise ShapeError(f"V must be (nv, d), got shape {V.shape}")
+    check_finite(V, "V")
     F, nv, edges, edge_of, count = _edges_of_faces(F, len(V))
     S = _matrix(F, nv, scheme, boundary, edges, edge_of, count)
     return np.asarray(S @ V), _split_faces(F, nv, edge_of)
