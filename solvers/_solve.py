@@ -203,6 +203,10 @@ def solve(
 
     **Arguments:**
     - `tol`: stop when the scaled max-norm KKT residual is `<= tol` (see `Problem.residual_scale`).
+      The test is on the residual, not on x: where the reduced Hessian has an eigenvalue λ, x
+      is determined to about `tol/λ` (the direct paths solve each Newton step exactly and return
+      x to round-off also for λ ≈ 1e-14; the Krylov path resolves each step to its `rtol`, so
+      give an energy with tiny curvatures its `residual_scale`, as for an energy of tiny scale).
     - `max_steps`: Newton steps (outer augmented-Lagrangian steps for `method="lbfgs"`).
     - `method`: `"dense"` (LU, n ≲ 2,000), `"sparse"` (a sparse direct solve of the KKT matrix
       assembled from a locality declaration, `dg.local_sum`, on the CPU: KLU for curves,

@@ -637,6 +637,16 @@ def solve_probes() -> list[Probe]:
     sp("elastica Euler buckling start (t_start = t_end ∥ chord)",
        lambda: _residual(solve(elastica.clamped(16, chord=(0.9, 0, 0), t_start=(1.0, 0, 0), t_end=(1.0, 0, 0)))),
        expect="value", expected=lambda: 0.0, )
+    sp("rod from zero frames, throw=False", lambda: _not_converged_flag(solve(_rod_with_x0(np.zeros((8, 4))), throw=False)),
+       names=(r"x0", r"frame", r"converge", r"unit", r"zero", r"singular"), expect="raises")
+    for method in ("dense", "sparse", "krylov"):
+        sp(f"elastica from a nan start, method={method}",
+           lambda method=method: solve(elastica.clamped(8, chord=(0.5, 0.2, 0), t_start=(1.0, 0, 0), t_end=(0, 1.0, 0),
+                                                        x0=np.where(np.arange(8)[:, None] == 3, np.nan, 1.0) * np.ones((8, 3))),
+                                       method=method), names=(r"x0", r"\b3\b"))
+    x0_kept = np.array([0.3, 1.0, 0.2])
+    probes.append(Probe("solve:x0 is not modified", lambda: _residual(solve(P(x0=x0_kept))), expect="value",
+                        expected=lambda: 0.0, inputs=(x0_kept,)))
     sp("multipliers0 of the wrong shape", lambda: solve(P(), multipliers0=np.zeros(3)), names=(r"multipliers0", r"shape"))
     sp("multipliers0 nan", lambda: solve(P(), multipliers0=np.array([np.nan])), names=(r"multipliers",))
     sp("x0 integer dtype", lambda: _residual(solve(dg.Problem(lambda x, p: jnp.sum((x - 0.5) ** 2), np.array([1, 2, 3])))),
