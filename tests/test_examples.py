@@ -13,8 +13,9 @@ FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", 
         "intrinsic_delaunay", "narrow_minimal_surface"]
 # the rod's KKT system takes minutes to compile on 2 cores, the bubbles' three KKT systems ~20 s
 # (their physics is checked by `ddgjax verify`, ext_bubbles), the catenoid fold's continuation ~10 s
-# (ext_continuation), the Willmore energies ~7 s (ext_willmore): run with `make test-all`
-SLOW = ["twisted_rod", "soap_bubble", "catenoid_fold", "willmore_sphere"]
+# (ext_continuation), the Willmore energies ~7 s and the Clifford torus ~60 s (ext_willmore): run with
+# `make test-all`
+SLOW = ["twisted_rod", "soap_bubble", "catenoid_fold", "willmore_sphere", "clifford_torus"]
 
 
 def load(name: str):
@@ -52,6 +53,9 @@ SHOWN = {
     "catenoid_fold.png": [("rectilinear", 5, [])] * 2,
     "willmore_sphere.png": [("3d", 0, ["Poly3DCollection"]), BAR],
     "willmore_convergence.png": [("rectilinear", 2, [])],  # |W − 4π| and the fitted slope
+    "clifford_torus.png": [("3d", 0, ["Poly3DCollection"]), BAR],
+    "clifford_profiles.png": [("rectilinear", 3, [])],  # the start, the solution and the axis
+    "clifford_convergence.png": [("rectilinear", 2, [])],  # |W/2π² − 1| and the fitted slope
 }
 
 

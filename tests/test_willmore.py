@@ -304,3 +304,40 @@ def test_helfrich_with_area_and_volume_solves_back_to_the_icosphere():
     assert abs(2 * area * lam_a + 3 * volume * lam_v) < 1e-8 * abs(2 * area * lam_a)
     assert abs(lam_v / lam_a + 2.126) < 1e-3
     assert abs(float(sol.energy) - _helfrich_energy_and_curvature(1)[0]) < 1e-10
+
+
+def test_torus_of_revolution_energy_is_the_helfrich_energy_of_the_revolved_mesh():
+    """The profile declaration sums the stars of one meridian, m times (rotational symmetry):
+    it equals `helfrich` of the whole revolved mesh (`revolve`) for any profile, here a random
+    perturbation of the start, and so do its gradients; negative control: one meridian alone."""
+    m, n = 10, 7
+    problem = willmore.torus_of_revolution(m, n)
+    P = np.asarray(problem.x0) + 0.05 * np.random.default_rng(3).normal(size=(n, 2))
+    V, F = mesh.torus(m, n)
+    whole = willmore.helfrich(V, F)
+    of_profile = lambda P: problem.energy(P, problem.params)  # noqa: E731
+    of_mesh = lambda P: whole.energy(willmore.revolve(P, m), whole.params)  # noqa: E731
+    W = float(of_profile(P))
+    assert abs(W - float(of_mesh(P))) < 1e-12 * W
+    assert np.max(np.abs(jax.grad(of_profile)(P) - jax.grad(of_mesh)(P))) < 1e-11 * W
+    assert abs(W / m - float(of_mesh(P))) > 0.5 * W
+
+
+def test_torus_of_revolution_constraints_and_start():
+    """The start is the circle of radius 1 about ρ = 2.5, equilateral, with its mean height at
+    z_0: the constraints vanish there; p_0 is the one fixed point."""
+    problem = willmore.torus_of_revolution(12, 8, ratio=2.5)
+    P = np.asarray(problem.x0)
+    assert np.allclose(np.linalg.norm(P - [2.5, 0.0], axis=1), 1.0)
+    g = problem.constraints(P, problem.params)
+    assert set(g) == {"equal_edges", "phase"} and g["equal_edges"].shape == (7,) and g["phase"].shape == (1,)
+    assert max(float(np.max(np.abs(v))) for v in g.values()) < 1e-14
+    assert np.asarray(problem.fixed).sum() == 2 and np.all(np.asarray(problem.fixed)[0])
+
+
+@pytest.mark.parametrize("kwargs, name", [(dict(m=2), "m"), (dict(n=2.5), "n"), (dict(ratio=1.0), "ratio"),
+                                          (dict(ratio=np.nan), "ratio"), (dict(kappa=0.0), "kappa")])
+def test_torus_of_revolution_rejects_bad_input(kwargs, name):
+    args = {"m": 12, "n": 8, **kwargs}
+    with pytest.raises(InvalidInputError, match=name):
+        willmore.torus_of_revolution(args.pop("m"), args.pop("n"), **args)
