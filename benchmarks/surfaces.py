@@ -59,7 +59,27 @@ intact (min A/mean A 0.36).  trust-constr stops on `xtol` at optimality 2e3 with
 mesh (min A/mean A 3e-6, W/2π² = 0.51); on 12×6 it drives W/2π² to 0.41.  On 48×24 (1152
 vertices, 50 steps) `minimize` is at W/2π² = 1.003, R/r = 1.52, residual 1.2 (not converged,
 23 s), trust-constr again at a degenerate mesh (W/2π² = 0.96, R/r = 1.33, min A/mean A 2e-6).
-So no converged Clifford-torus row exists yet; the rows are printed as "not converged".
+So no converged row of the free torus exists; those rows are printed as "not converged".
+
+**Clifford torus as a torus of revolution** (`--revolution m×n …`, the converged rows).
+`energies.willmore.torus_of_revolution(m, n)`: the same Helfrich energy of the revolved mesh
+(m n vertices), with the profile polygon (n points) as the unknowns, its edges equal and p_0 and
+its mean height fixed (its docstring), from R/r = 2.5.  ddgjax: `solve(problem,
+tol=--torus-tol)`; scipy: trust-constr on the 2n − 2 free entries with the n constraints (exact
+dense Jacobian, Hessian-vector products of the energy and of λ·g), same tolerance and budget.
+Measured (`--levels --refine --no-torus --revolution 24x12 96x48 448x224 --repeats 3
+--scipy-budget 120`, 2 cores, load 1–2.6, 2026-12-04; tol 1e-8):
+
+| vertices (m × n) | ddgjax solve s | steps | residual | W/2π² | R/r | trust-constr s | its steps, residual | ratio |
+|---:|---:|---:|---:|---:|---:|---:|---|---:|
+| 288 (24 × 12) | 0.007 | 5 | 5.4e-12 | 0.953261 | 1.36990 | 0.39 | 31, 1.0e-7 (xtol), same W | 52× |
+| 4,608 (96 × 48) | 0.021 | 5 | 2.7e-12 | 0.997001 | 1.41148 | 2.10 | 46, 4.7e-7 (xtol), same W | 101× |
+| 100,352 (448 × 224) | 0.102 | 5 | 3.8e-10 | 0.999862 | 1.41409 | > 120 | 101, 3.2 (not finished; W/2π² 1.153) | > 1,177× |
+
+Compile 14–16 s per size.  W/2π² − 1 and R/r − √2 fall at order 2 in 1/n (`ddgjax verify --only
+clifford`).  At 10⁵ vertices the KKT residual cannot go below ~3e-10 in float64 (the m = 448
+meridians multiply every star's terms): `tol=1e-10` stalls there (measured: 49 Newton steps
+and the L-BFGS retry, 48 s, ending at 2.9e-10 with the same W), so the rows use --torus-tol.
 
 **Columns.**  compile s = first call minus the median of the later ones (ddgjax); solve s = the
 median of --repeats calls after warm-up (one call above 5·10⁴ vertices; scipy: one call);
@@ -102,7 +122,7 @@ compare rows of one run only.
 
     python benchmarks/surfaces.py [--quick] [--levels 4 5 6 7] [--repeats 3] [--scipy-max 30000]
                                   [--scipy-budget 120] [--torus 24x12 48x24] [--torus-steps 50]
-                                  [--no-torus]
+                                  [--no-torus] [--revolution 24x12 96x48 448x224]
 
 (`--levels` with no value: the torus only.)
 """
@@ -297,6 +317,74 @@ def torus_rows(m: int, n: int, args) -> list[str]:
     return rows
 
 
+def profile_ratio(P) -> float:
+    """R/r of a torus of revolution from its profile: the centroid's ρ over the mean distance to it."""
+    P = np.asarray(P)
+    centre = P.mean(axis=0)
+    return float(centre[0] / np.mean(np.linalg.norm(P - centre, axis=1)))
+
+
+class ProfileTrustConstr(TrustConstr):
+    """trust-constr on the free entries of a problem with vector constraints (all named ones,
+    flattened): exact gradient, Hessian-vector products of the energy and of λ·g, the dense
+    constraint Jacobian (`jax.jacfwd`)."""
+
+    def __init__(self, problem):
+        x0 = jnp.asarray(problem.x0, dtype=jnp.float64)
+        free = ~np.asarray(problem.fixed)
+        params = problem.params
+        x_of = lambda u: x0.at[free].set(u)  # noqa: E731
+        energy = lambda u: problem.energy(x_of(u), params)  # noqa: E731
+        g = lambda u: jnp.concatenate([jnp.ravel(v) for v in jax.tree_util.tree_leaves(problem.constraints(x_of(u), params))])  # noqa: E731
+        self.u0 = np.asarray(x0[free])
+        self.f, self.df, self.hf = self._derivatives(energy)
+        self.shape = (-1, 2)
+        self.x_of = lambda u: np.asarray(x_of(jnp.asarray(u)))  # noqa: E731
+        g_jit, jac = jax.jit(g), jax.jit(jax.jacfwd(g))
+        weighted = lambda u, v, w: jax.jvp(jax.grad(lambda u: jnp.dot(w, g(u))), (u,), (v,))[1]  # noqa: E731
+        hg = jax.jit(weighted)
+        u = jnp.asarray(self.u0)
+        m = int(g_jit(u).size)
+        for value in (self.f(u), self.df(u), self.hf(u, u), g_jit(u), jac(u), hg(u, u, jnp.ones(m))):
+            jax.block_until_ready(value)  # compile before the clock starts
+        n = self.u0.size
+        self.constraint = scipy.optimize.NonlinearConstraint(
+            lambda u: np.asarray(g_jit(jnp.asarray(u))), 0.0, 0.0, jac=lambda u: np.asarray(jac(jnp.asarray(u))),
+            hess=lambda u, v: spla.LinearOperator((n, n), dtype=np.float64, matvec=lambda d: np.asarray(
+                hg(jnp.asarray(u), jnp.asarray(d, dtype=jnp.float64).ravel(), jnp.asarray(v)))))
+
+    def run(self, tol: float, budget: float) -> dict:
+        t0 = time.perf_counter()
+        result = scipy.optimize.minimize(
+            lambda u: float(self.f(jnp.asarray(u))), self.u0, jac=lambda u: np.asarray(self.df(jnp.asarray(u))),
+            hess=lambda u: self._operator(self.hf, u), method="trust-constr", constraints=[self.constraint],
+            options={"gtol": tol, "xtol": 1e-14, "maxiter": 100_000},
+            callback=lambda x, state: time.perf_counter() - t0 > budget)
+        seconds = time.perf_counter() - t0
+        return {"solve": seconds, "steps": int(result.nit), "x": self.x_of(result.x), "energy": float(result.fun),
+                "residual": float(result.optimality), "violation": float(result.constr_violation),
+                "finished": result.status in (1, 2) and seconds <= budget, "message": result.message,
+                "xtol": result.status == 2}
+
+
+def revolution_rows(m: int, n: int, args) -> list[str]:
+    """The Willmore torus of revolution (`willmore.torus_of_revolution(m, n)`, module docstring)."""
+    problem = willmore.torus_of_revolution(m, n)
+    run = lambda: solve(problem, tol=args.torus_tol, throw=False)  # noqa: E731
+    sol, compile_s, solve_s = timed(run, args.repeats)
+    w = float(sol.energy) / (2 * np.pi**2)
+    state = "" if bool(sol.converged) else f" not converged (residual {float(sol.residual):.1e})"
+    rows = [f"| torus of revolution | {m * n} | ddgjax solve | {compile_s:.1f} | {solve_s:.3f}{state} | {int(sol.steps)} | "
+            f"{float(sol.residual):.1e} | — | {float(sol.energy):.6f} | W/2π² = {w:.6f}, R/r = {profile_ratio(sol.x):.5f} | "
+            f"{peak_mb():.0f} | |"]
+    print(rows[0], flush=True)
+    if m * n <= args.scipy_max * 4:
+        rows.append(scipy_row("torus of revolution", m * n, ProfileTrustConstr(problem), args.torus_tol, args.scipy_budget,
+                              solve_s, lambda r: f"W/2π² = {r['energy'] / (2 * np.pi**2):.6f}, R/r = {profile_ratio(r['x']):.5f}"))
+        print(rows[-1], flush=True)
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="bubbles up to ~6·10³ vertices, the coarse torus")
@@ -311,6 +399,8 @@ def main():
     ap.add_argument("--torus-tol", type=float, default=1e-8)
     ap.add_argument("--torus-steps", type=int, default=50)
     ap.add_argument("--no-torus", action="store_true")
+    ap.add_argument("--revolution", nargs="*", default=None,
+                    help="sizes m×n of the Willmore torus of revolution (default 24x12 96x48 448x224; none: no rows)")
     args = ap.parse_args()
     levels = args.levels if args.levels is not None else ([4, 5] if args.quick else [4, 5, 6, 7])
     if args.refine is None:
@@ -327,6 +417,9 @@ def main():
         rows += refined_bubble_rows(args)
     for m, n in tori:
         rows += torus_rows(m, n, args)
+    revolution = args.revolution if args.revolution is not None else (["24x12", "96x48"] if args.quick else ["24x12", "96x48", "448x224"])
+    for m, n in (tuple(map(int, size.split("x"))) for size in revolution):
+        rows += revolution_rows(m, n, args)
     print("\n| problem | vertices | solver | compile s | solve s | steps | residual | volume error | area / W | "
           "result | peak MB | scipy s / ddgjax s |")
     print("|---|---:|---|---:|---:|---:|---:|---:|---:|---|---:|---:|")
