@@ -34,7 +34,7 @@ import sys
 import tempfile
 import time
 import traceback
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
@@ -320,7 +320,6 @@ def topology_probes() -> list[Probe]:
 
 
 def intrinsic_probes() -> list[Probe]:
-    import ddgjax as dg
     from ddgjax import intrinsic, mesh
 
     V, F = probe_meshes()["closed"]
@@ -380,10 +379,7 @@ def _scaled_lengths(f, F, L, s, p):
             return (np.asarray(r[0]) * s**p, r[1])
         return np.asarray(r, float) * s**p
 
-    def wrapped():
-        return expected()
-
-    return wrapped
+    return expected
 
 
 # ---------------------------------------------------------------------------------- curves

@@ -32,7 +32,6 @@ import numpy as np
 from ..errors import (
     GluingError,
     MeshError,
-    NonFiniteError,
     ShapeError,
     TriangleInequalityError,
 )

@@ -27,8 +27,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .._checks import check_finite, check_positive, is_concrete
-from ..errors import MeshError, OrientationError, ShapeError, SingularVertexError
+from .._checks import check_positive, is_concrete
+from ..errors import MeshError, OrientationError, SingularVertexError
 from .connectivity import Halfedges, check_has_faces, checked_corners, faces_as_corners, from_faces
 from .lengths import check_positions
 from .lengths import (
