@@ -67,7 +67,8 @@ from ddgjax.mesh.connectivity import glue_triangles
 from .area import face_area, face_volume
 
 __all__ = ["circle_angle", "circle_angles", "conformal", "edge_stencil", "helfrich", "mean_curvature", "revolve",
-           "star_stencil", "torus_of_revolution", "vertex_density"]
+           "revolve_vesicle", "revolved_stars", "star_stencil", "torus_of_revolution", "vertex_density",
+           "vesicle_of_revolution"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -237,14 +238,34 @@ def revolve(P: Float[Array, "n 2"], m: int) -> Float[Array, "mn 3"]:
     return jnp.stack([X, Y, jnp.broadcast_to(z[None, :], X.shape)], axis=-1).reshape(-1, 3)
 
 
-def _meridian_star(Q: Float[Array, "3 2"], star: dict, params: dict) -> Float[Array, ""]:
-    """m times the Helfrich density of the star of the vertex (0, j) of the revolved torus, from
-    the profile points Q = (p_{j−1}, p_j, p_{j+1}): star vertex s sits at the profile point
-    `which[s]` turned by the meridian angle `angle[s]`.  By the rotational symmetry every
-    meridian's stars contribute alike, so Σ_j of this is W of the whole torus."""
+def _revolved(Q, star):
+    """The star's vertices in R³: vertex s at the profile point Q[which[s]] = (ρ, z) turned by
+    the meridian angle angle[s] about the z-axis."""
     rho, z = Q[star["which"], 0], Q[star["which"], 1]
-    X = jnp.stack([rho * jnp.cos(star["angle"]), rho * jnp.sin(star["angle"]), z], axis=1)
-    return star["meridians"] * vertex_density(X, star, params)
+    return jnp.stack([rho * jnp.cos(star["angle"]), rho * jnp.sin(star["angle"]), z], axis=1)
+
+
+def _revolved_star(Q: Float[Array, "3 2"], star: dict, params: dict) -> Float[Array, ""]:
+    """`weight` times the Helfrich density (`vertex_density`) of one vertex star of a surface of
+    revolution, from the profile points Q of its stencil: by the rotational symmetry the stars
+    of one meridian, each counted m times (once at a pole), sum to W of the whole surface."""
+    return star["weight"] * vertex_density(_revolved(Q, star), star, params)
+
+
+def revolved_stars(F, profile_of: np.ndarray, angle_of: np.ndarray, rows: np.ndarray, cells: np.ndarray,
+                   weights: np.ndarray) -> dict:
+    """The `dg.local_sum` data of `_revolved_star` for the surface (V, F) of revolution whose
+    vertex v is the profile point `profile_of[v]` turned by `angle_of[v]`: the stars of the
+    vertices `rows` (one per profile point), each with the stencil of profile points `cells[k]`
+    (3 of them, repeats allowed) and the weight `weights[k]`."""
+    stencil, star = star_stencil(F, len(profile_of))
+    star = {key: value[rows] for key, value in star.items()}
+    on = profile_of[stencil[rows]]  # (rows, s): the profile point of each star vertex
+    star["which"] = np.argmax(on[:, :, None] == cells[:, None, :], axis=2)
+    assert np.all(np.take_along_axis(cells, star["which"], axis=1) == on), "a star vertex off its stencil"
+    star["angle"] = angle_of[stencil[rows]]
+    star["weight"] = np.asarray(weights, dtype=float)
+    return star
 
 
 def _edge_difference(Q: Float[Array, "4 2"], params) -> Float[Array, ""]:
@@ -294,14 +315,11 @@ def torus_of_revolution(m: int, n: int, *, ratio: float = 2.5, kappa: float = 1.
         raise InvalidInputError(f"ratio = R/r of the starting torus must be > 1 (the profile circle must not meet the axis), got {ratio}")
     V0, F = dg.mesh.torus(m, n, R=float(ratio), r=1.0)
     _closed(V0, F)
-    stencil, star = star_stencil(F, len(V0))
     j = np.arange(n)
-    ring = stencil[:n]  # the stars of the meridian u = 0: vertex (0, j) has index j
-    star = {key: value[:n] for key, value in star.items()}
-    star["which"] = (ring % n - j[:, None] + 1) % n  # 0, 1, 2: the star vertex is on p_{j−1}, p_j, p_{j+1}
-    star["angle"] = 2 * np.pi * np.where(ring // n == m - 1, -1, ring // n) / m
-    star["meridians"] = np.full(n, float(m))
-    energy = dg.local_sum(_meridian_star, np.stack([(j - 1) % n, j, (j + 1) % n], axis=1), star)
+    vertex = np.arange(m * n)  # vertex i n + j: profile point j on meridian i
+    cells = np.stack([(j - 1) % n, j, (j + 1) % n], axis=1)
+    star = revolved_stars(F, vertex % n, 2 * np.pi * (vertex // n) / m, j, cells, np.full(n, float(m)))
+    energy = dg.local_sum(_revolved_star, cells, star)
     rest = j[1:]
     constraints = dg.concat(
         equal_edges=dg.local_map(_edge_difference, np.stack([rest, (rest + 1) % n, 0 * rest, 0 * rest + 1], axis=1)),
@@ -313,6 +331,100 @@ def torus_of_revolution(m: int, n: int, *, ratio: float = 2.5, kappa: float = 1.
     fixed[0] = True
     return dg.Problem(energy, P0, constraints=constraints, params={"kappa": float(kappa), "H0": 0.0}, fixed=fixed,
                       name=f"Willmore energy of tori of revolution (m={m}, n={n})")
+
+
+def _sphere_of_revolution(m: int, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`(F, profile_of, angle_of)` of the sphere of revolution of a profile p_0 … p_n from the
+    north pole p_0 to the south pole p_n (both on the axis), m meridians: vertex 0 the north
+    pole, 1 + i (n − 1) + j − 1 the point p_j (0 < j < n) on meridian i, 1 + m (n − 1) the south
+    pole; fans at the poles, each quad of the rings split in two, outward for a profile running
+    from the north pole down the half-plane ρ > 0."""
+    i, j = np.meshgrid(np.arange(m), np.arange(1, n - 1), indexing="ij")
+    ring = lambda i, j: 1 + (i % m) * (n - 1) + j - 1  # noqa: E731
+    south = 1 + m * (n - 1)
+    k = np.arange(m)
+    a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j)
+    F = np.concatenate([
+        np.stack([np.zeros(m, int), ring(k, 1), ring(k + 1, 1)], axis=1),
+        np.stack([a, b, c], axis=-1).reshape(-1, 3), np.stack([a, c, d], axis=-1).reshape(-1, 3),
+        np.stack([np.full(m, south), ring(k + 1, n - 1), ring(k, n - 1)], axis=1),
+    ])
+    profile_of = np.concatenate([[0], np.tile(np.arange(1, n), m), [n]])
+    angle_of = np.concatenate([[0.0], np.repeat(2 * np.pi * np.arange(m) / m, n - 1), [0.0]])
+    return F, profile_of, angle_of
+
+
+def _star_area_and_volume(Q: Float[Array, "3 2"], star: dict, params: dict) -> Float[Array, "2"]:
+    """`weight` × (A_i, Vol_i) − share × (area, volume): A_i = ⅓ Σ_{f ∋ i} A(f) and
+    Vol_i = ⅓ Σ_{f ∋ i} det(f)/6 of the star, so that the weighted sum over one meridian's stars
+    is (A(S) − area, Vol(S) − volume) of the whole surface of revolution."""
+    X = _revolved(Q, star)
+    T = X[jnp.concatenate([jnp.zeros_like(star["faces"][:, :1]), star["faces"]], axis=1)]
+    measures = jnp.stack([jnp.sum(star["mask"] * jax.vmap(face_area)(T)), jnp.sum(star["mask"] * jax.vmap(face_volume)(T))])
+    return star["weight"] * measures / 3.0 - star["share"] * jnp.stack([params["area"], params["volume"]])
+
+
+def vesicle_of_revolution(m: int, n: int, *, reduced_volume: float = 0.6, aspect: float = 0.6,
+                          kappa: float = 1.0) -> dg.Problem:
+    """A closed vesicle of revolution under area and volume constraints (the Helfrich model of a
+    lipid membrane with H₀ = 0, Canham 1970, Helfrich 1973): W = κ∫H² dA of the profile polygon
+    P (n + 1, 2) of points (ρ_j, z_j) from the north pole p_0 to the south pole p_n, revolved into
+    m meridians (the stars of one meridian counted m times, the poles' once; `revolved_stars`).
+
+    - constraint `"measures"` (2,): the area A and the volume Vol of the surface are those of
+      the start (an oblate spheroid of semi-axes 1, 1, `aspect`) and `reduced_volume` v times the
+      volume of the round sphere of that area, v = Vol / (4π/3 (A/4π)^{3/2});
+    - constraint `"equal_edges"` (n − 1,): the profile is equilateral (as for
+      `torus_of_revolution`: without it the vertices slide);
+    - p_0 fixed (translation along the axis), the south pole's ρ fixed at 0 (on the axis).
+
+    At v ≈ 0.6 the minimiser is the biconcave discocyte, the shape of a red blood cell
+    (Seifert, Berndl, Lipowsky 1991): thinner at the axis than at its rim.  Params `{"kappa",
+    "H0", "area", "volume"}`; multipliers `{"equal_edges": (n − 1,), "measures": (2,)}` (the
+    tension and the pressure).
+
+    **Raises:** `InvalidInputError` (m < 3, n < 3, `reduced_volume` not in (0, 1), `aspect` not
+    positive, `kappa` not finite and positive).
+    """
+    m = checked_count(m, 3, "m, the number of meridians,")
+    n = checked_count(n, 3, "n, the number of profile edges,")
+    check_positive(kappa, "kappa, the bending rigidity,")
+    check_positive(aspect, "aspect, the starting spheroid's polar semi-axis,")
+    if not (0 < reduced_volume < 1):
+        raise InvalidInputError(f"reduced_volume must lie in (0, 1) (1 is the round sphere), got {reduced_volume}")
+    F, profile_of, angle_of = _sphere_of_revolution(m, n)
+    theta = np.pi * np.arange(n + 1) / n
+    P0 = np.stack([np.sin(theta), aspect * np.cos(theta)], axis=1)
+    P0[[0, n], 0] = 0.0
+    V0 = np.stack([P0[profile_of, 0] * np.cos(angle_of), P0[profile_of, 0] * np.sin(angle_of), P0[profile_of, 1]], axis=1)
+    _closed(V0, F)
+    rows = np.concatenate([[0], 1 + np.arange(n - 1), [len(V0) - 1]])  # the poles and meridian 0
+    j = np.arange(1, n)
+    cells = np.concatenate([[[0, 0, 1]], np.stack([j - 1, j, j + 1], axis=1), [[n - 1, n, n]]])
+    weights = np.concatenate([[1.0], np.full(n - 1, float(m)), [1.0]])
+    star = revolved_stars(F, profile_of, angle_of, rows, cells, weights)
+    star["share"] = np.full(len(rows), 1.0 / len(rows))
+    area0 = float(dg.mesh.surface_area(V0, F))
+    volume = float(reduced_volume) * 4 * np.pi / 3 * (area0 / (4 * np.pi)) ** 1.5
+    constraints = dg.concat(
+        equal_edges=dg.local_map(_edge_difference, np.stack([j, j + 1, 0 * j, 0 * j + 1], axis=1)),
+        measures=dg.local_sum(_star_area_and_volume, cells, star),
+    )
+    fixed = np.zeros((n + 1, 2), bool)
+    fixed[0] = True
+    fixed[n, 0] = True
+    return dg.Problem(dg.local_sum(_revolved_star, cells, star), P0, constraints=constraints,
+                      params={"kappa": float(kappa), "H0": 0.0, "area": area0, "volume": volume}, fixed=fixed,
+                      name=f"vesicle of revolution (m={m}, n={n}, v={reduced_volume})")
+
+
+def revolve_vesicle(P: Float[Array, "n1 2"], m: int) -> tuple[np.ndarray, np.ndarray]:
+    """`(V, F)` of the vesicle of revolution of the profile P (n + 1, 2), m meridians (the mesh
+    `vesicle_of_revolution` declares its energy on)."""
+    P = np.asarray(P)
+    F, profile_of, angle_of = _sphere_of_revolution(m, len(P) - 1)
+    rho, z = P[profile_of, 0], P[profile_of, 1]
+    return np.stack([rho * np.cos(angle_of), rho * np.sin(angle_of), z], axis=1), F
 
 
 # ---------------------------------------------------------------------------------------------

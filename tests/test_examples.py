@@ -13,9 +13,9 @@ FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", 
         "intrinsic_delaunay", "narrow_minimal_surface"]
 # the rod's KKT system takes minutes to compile on 2 cores, the bubbles' three KKT systems ~20 s
 # (their physics is checked by `ddgjax verify`, ext_bubbles), the catenoid fold's continuation ~10 s
-# (ext_continuation), the Willmore energies ~7 s and the Clifford torus ~60 s (ext_willmore): run with
+# (ext_continuation), the Willmore energies ~7 s and the Clifford torus ~60 s, the red blood cell ~30 s (ext_willmore): run with
 # `make test-all`
-SLOW = ["twisted_rod", "soap_bubble", "catenoid_fold", "willmore_sphere", "clifford_torus"]
+SLOW = ["twisted_rod", "soap_bubble", "catenoid_fold", "willmore_sphere", "clifford_torus", "red_blood_cell"]
 
 
 def load(name: str):
@@ -56,6 +56,8 @@ SHOWN = {
     "clifford_torus.png": [("3d", 0, ["Poly3DCollection"]), BAR],
     "clifford_profiles.png": [("rectilinear", 3, [])],  # the start, the solution and the axis
     "clifford_convergence.png": [("rectilinear", 2, [])],  # |W/2π² − 1| and the fitted slope
+    "red_blood_cell.png": [("3d", 0, ["Poly3DCollection"]), BAR],
+    "red_blood_cell_section.png": [("rectilinear", 2, [])],  # the start and the discocyte
 }
 
 

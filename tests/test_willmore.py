@@ -341,3 +341,61 @@ def test_torus_of_revolution_rejects_bad_input(kwargs, name):
     args = {"m": 12, "n": 8, **kwargs}
     with pytest.raises(InvalidInputError, match=name):
         willmore.torus_of_revolution(args.pop("m"), args.pop("n"), **args)
+
+
+def test_vesicle_of_revolution_energy_and_measures_are_those_of_the_revolved_mesh():
+    """The profile declaration of the vesicle (one meridian's stars times m, the poles once)
+    equals `helfrich` of the revolved closed mesh, and its "measures" constraint the area and the
+    enclosed volume of that mesh, for a random profile (poles on the axis)."""
+    m, n = 9, 6
+    problem = willmore.vesicle_of_revolution(m, n, reduced_volume=0.7)
+    P = np.asarray(problem.x0) + 0.03 * np.random.default_rng(4).normal(size=(n + 1, 2))
+    P[[0, n], 0] = 0.0
+    V, F = willmore.revolve_vesicle(P, m)
+    assert mesh.euler_characteristic(F) == 2 and mesh.is_orientable(F)
+    whole = willmore.helfrich(V, F)
+    W = float(problem.energy(P, problem.params))
+    assert abs(W - float(whole.energy(V, whole.params))) < 1e-12 * W
+    g = problem.constraints(P, problem.params)["measures"]
+    a, b, c = (V[F[:, i]] for i in range(3))
+    volume = np.sum(np.einsum("ij,ij->i", a, np.cross(b, c))) / 6
+    assert volume > 0  # outward
+    assert abs(float(g[0]) + problem.params["area"] - float(mesh.surface_area(V, F))) < 1e-12
+    assert abs(float(g[1]) + problem.params["volume"] - volume) < 1e-12
+
+
+def test_vesicle_at_reduced_volume_0_6_is_a_biconcave_minimum():
+    """Seifert–Berndl–Lipowsky 1991: at v = 0.6 the Helfrich vesicle (H₀ = 0) from an oblate
+    start is the discocyte: the constraints hold (v = 0.6 to 1e-12), it is a minimum
+    (stability index 0), and it is biconcave: thinner on the axis than at its thickest (by more
+    than half; negative control: the oblate start is thickest on the axis)."""
+    from solvers import solve, stability
+
+    m, n = 32, 16
+    problem = willmore.vesicle_of_revolution(m, n, reduced_volume=0.6)
+    sol = solve(problem)
+    P = np.asarray(sol.x)
+    V, F = willmore.revolve_vesicle(P, m)
+    a, b, c = (V[F[:, i]] for i in range(3))
+    area = float(mesh.surface_area(V, F))
+    volume = np.sum(np.einsum("ij,ij->i", a, np.cross(b, c))) / 6
+    assert abs(volume / (4 * np.pi / 3 * (area / (4 * np.pi)) ** 1.5) - 0.6) < 1e-12
+    assert stability(problem, sol).index == 0
+
+    def thickness(P):
+        """(on the axis, largest): twice the heights above the midplane of the poles."""
+        mid = 0.5 * (P[0, 1] + P[-1, 1])
+        return P[0, 1] - P[-1, 1], 2 * (np.max(P[:, 1]) - mid)
+
+    on_axis, largest = thickness(P)
+    assert on_axis < 0.5 * largest
+    start_axis, start_largest = thickness(np.asarray(problem.x0))
+    assert start_axis >= start_largest - 1e-12
+
+
+@pytest.mark.parametrize("kwargs, name", [(dict(reduced_volume=1.0), "reduced_volume"), (dict(aspect=0.0), "aspect"),
+                                          (dict(m=2), "m")])
+def test_vesicle_of_revolution_rejects_bad_input(kwargs, name):
+    args = {"m": 12, "n": 8, **kwargs}
+    with pytest.raises(InvalidInputError, match=name):
+        willmore.vesicle_of_revolution(args.pop("m"), args.pop("n"), **args)
