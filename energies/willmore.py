@@ -67,7 +67,7 @@ from ddgjax.mesh.connectivity import glue_triangles
 from .area import face_area, face_volume
 
 __all__ = ["circle_angle", "circle_angles", "conformal", "edge_stencil", "helfrich", "mean_curvature", "revolve",
-           "revolve_vesicle", "revolved_stars", "star_stencil", "torus_of_revolution", "vertex_density",
+           "revolve_vesicle", "revolved_points", "revolved_stars", "star_stencil", "torus_of_revolution", "vertex_density",
            "vesicle_of_revolution"]
 
 
@@ -227,22 +227,30 @@ def helfrich(V, F, *, kappa: float = 1.0, H0: float = 0.0, area: float | None = 
 # tori of revolution: the Willmore problem on a profile polygon
 
 
+def revolved_points(P: Float[Array, "n 2"], profile_of, angle_of) -> Float[Array, "k 3"]:
+    """Points of a surface of revolution about the z-axis: point v is the profile point
+    P[profile_of[v]] = (ρ, z) turned by the angle angle_of[v], (ρ cos a, ρ sin a, z)."""
+    rho, z = P[profile_of, 0], P[profile_of, 1]
+    return jnp.stack([rho * jnp.cos(angle_of), rho * jnp.sin(angle_of), z], axis=-1)
+
+
+def _torus_of_revolution(m: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """`(profile_of, angle_of)` of the vertices of `dg.mesh.torus(m, n)`: vertex i n + j is the
+    profile point j on the meridian u_i = 2πi/m."""
+    vertex = np.arange(m * n)
+    return vertex % n, 2 * np.pi * (vertex // n) / m
+
+
 def revolve(P: Float[Array, "n 2"], m: int) -> Float[Array, "mn 3"]:
     """The vertices of the torus of revolution of the closed profile polygon P = (ρ_j, z_j)
     (n, 2) about the z-axis, m meridians: v_{i,j} = (ρ_j cos u_i, ρ_j sin u_i, z_j),
     u_i = 2πi/m, as an (m n, 3) array ordered like `dg.mesh.torus(m, n)` (vertex i n + j)."""
-    u = 2 * np.pi * np.arange(m) / m
-    rho, z = P[:, 0], P[:, 1]
-    X = rho[None, :] * np.cos(u)[:, None]
-    Y = rho[None, :] * np.sin(u)[:, None]
-    return jnp.stack([X, Y, jnp.broadcast_to(z[None, :], X.shape)], axis=-1).reshape(-1, 3)
+    return revolved_points(P, *_torus_of_revolution(m, jnp.shape(P)[0]))
 
 
 def _revolved(Q, star):
-    """The star's vertices in R³: vertex s at the profile point Q[which[s]] = (ρ, z) turned by
-    the meridian angle angle[s] about the z-axis."""
-    rho, z = Q[star["which"], 0], Q[star["which"], 1]
-    return jnp.stack([rho * jnp.cos(star["angle"]), rho * jnp.sin(star["angle"]), z], axis=1)
+    """The star's vertices in R³ (`revolved_points` of its stencil's profile points)."""
+    return revolved_points(Q, star["which"], star["angle"])
 
 
 def _revolved_star(Q: Float[Array, "3 2"], star: dict, params: dict) -> Float[Array, ""]:
@@ -316,9 +324,8 @@ def torus_of_revolution(m: int, n: int, *, ratio: float = 2.5, kappa: float = 1.
     V0, F = dg.mesh.torus(m, n, R=float(ratio), r=1.0)
     _closed(V0, F)
     j = np.arange(n)
-    vertex = np.arange(m * n)  # vertex i n + j: profile point j on meridian i
     cells = np.stack([(j - 1) % n, j, (j + 1) % n], axis=1)
-    star = revolved_stars(F, vertex % n, 2 * np.pi * (vertex // n) / m, j, cells, np.full(n, float(m)))
+    star = revolved_stars(F, *_torus_of_revolution(m, n), j, cells, np.full(n, float(m)))
     energy = dg.local_sum(_revolved_star, cells, star)
     rest = j[1:]
     constraints = dg.concat(
@@ -396,7 +403,7 @@ def vesicle_of_revolution(m: int, n: int, *, reduced_volume: float = 0.6, aspect
     theta = np.pi * np.arange(n + 1) / n
     P0 = np.stack([np.sin(theta), aspect * np.cos(theta)], axis=1)
     P0[[0, n], 0] = 0.0
-    V0 = np.stack([P0[profile_of, 0] * np.cos(angle_of), P0[profile_of, 0] * np.sin(angle_of), P0[profile_of, 1]], axis=1)
+    V0 = np.asarray(revolved_points(P0, profile_of, angle_of))
     _closed(V0, F)
     rows = np.concatenate([[0], 1 + np.arange(n - 1), [len(V0) - 1]])  # the poles and meridian 0
     j = np.arange(1, n)
@@ -423,8 +430,7 @@ def revolve_vesicle(P: Float[Array, "n1 2"], m: int) -> tuple[np.ndarray, np.nda
     `vesicle_of_revolution` declares its energy on)."""
     P = np.asarray(P)
     F, profile_of, angle_of = _sphere_of_revolution(m, len(P) - 1)
-    rho, z = P[profile_of, 0], P[profile_of, 1]
-    return np.stack([rho * np.cos(angle_of), rho * np.sin(angle_of), z], axis=1), F
+    return np.asarray(revolved_points(P, profile_of, angle_of)), F
 
 
 # ---------------------------------------------------------------------------------------------

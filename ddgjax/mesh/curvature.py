@@ -231,11 +231,13 @@ def _normalised_area_vectors(V, F):
     concrete F is checked first (`connectivity.checked_corners`: indices of vertices of V, no
     repeated vertex in a face)."""
     if is_concrete(F):
-        checked_corners(np.asarray(F) if hasattr(F, "shape") else F, jnp.shape(V)[0])
+        vertex, face, nxt = checked_corners(np.asarray(F) if hasattr(F, "shape") else F, jnp.shape(V)[0])
+        n_faces = int(face.max()) + 1
+    else:  # traced faces of an (nf, k) array
+        vertex, nxt, _ = _corners(F)
+        n_faces, k = jnp.shape(F)
+        face = np.repeat(np.arange(n_faces), k)
     V, s = normalised(jnp.asarray(V))
-    vertex, nxt, _ = _corners(F)
-    face = np.repeat(np.arange(jnp.shape(F)[0]), jnp.shape(F)[1]) if hasattr(F, "shape") else faces_as_corners(F)[1]
-    n_faces = int(face.max()) + 1 if face.size else 0
     return _area_vectors(V, vertex, nxt, face, n_faces), s
 
 
