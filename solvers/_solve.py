@@ -102,6 +102,18 @@ def sparse_direct_for(problem: Problem, spec: Spec) -> LinearSolver:
     return SparseDirect()
 
 
+def krylov_for(problem: Problem, spec: Spec) -> LinearSolver:
+    """`method="krylov"`: MINRES preconditioned by the multigrid cycle for an unconstrained
+    problem declared local that is not a chain (a mesh: the cycle's iteration count barely grows
+    with the mesh, where the Jacobi metric's grows with the condition number), `Krylov()`
+    otherwise (GMRES with the block-tridiagonal preconditioner on chains; MINRES on the
+    constraints' tangent space with the Jacobi metric).  On an accelerator this is what
+    `method="auto"` runs for large meshes (`benchmarks/accelerator.py`)."""
+    if spec.is_local and spec.m == 0 and not is_chain(problem, spec):
+        return Krylov(preconditioner="amg")
+    return Krylov()
+
+
 def linear_solver_of(problem: Problem, spec: Spec, method: str, linear_solver: LinearSolver | None) -> LinearSolver:
     """The bound linear solver of a solve: `linear_solver` if given, else the one `method` names."""
     if linear_solver is None:
@@ -112,7 +124,8 @@ def linear_solver_of(problem: Problem, spec: Spec, method: str, linear_solver: L
                 "method='sparse' needs an energy declared with dg.local_sum (and constraints with "
                 "dg.local_map / dg.local_sum / dg.concat) over a single array of unknowns"
             )
-        linear_solver = {"dense": DenseLU, "krylov": Krylov}.get(method, lambda: sparse_direct_for(problem, spec))()
+        linear_solver = {"dense": DenseLU, "krylov": lambda: krylov_for(problem, spec)}.get(
+            method, lambda: sparse_direct_for(problem, spec))()
     elif not isinstance(linear_solver, LinearSolver):
         raise InvalidInputError(
             f"linear_solver must be a solvers.LinearSolver (DenseLU(), KLU(), SparseDirect(), Krylov()), "

@@ -56,6 +56,28 @@ def test_amg_krylov_converges_to_the_sparse_direct_answer():
     assert abs(int(amg.steps) - int(direct.steps)) <= 1
 
 
+def test_method_krylov_takes_the_multigrid_cycle_on_unconstrained_meshes_only():
+    """`method="krylov"` (what `method="auto"` runs for large problems on an accelerator): the
+    multigrid cycle for an unconstrained mesh, whose answer is the direct one; the Jacobi
+    metric for a constrained mesh (a bubble: the cycle takes no constraints) and the
+    block-tridiagonal preconditioner for a chain (the elastica)."""
+    from energies import elastica
+    from solvers._solve import linear_solver_of
+
+    def chosen(problem):
+        return linear_solver_of(problem, spec_of(problem), "krylov", None)
+
+    mesh = _saddle(12)
+    assert chosen(mesh).preconditioner == "amg" and chosen(mesh).hierarchy is not None
+    V, F = dg.mesh.icosphere(1)
+    bubble = area.with_volume(V, F, 4.0)
+    assert chosen(bubble).preconditioner == "jacobi"
+    curve = elastica.clamped(12, chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+    assert chosen(curve).preconditioner == "jacobi" and chosen(curve).chain is not None
+    krylov, direct = solve(mesh, method="krylov", tol=1e-10), solve(mesh, method="sparse", tol=1e-10)
+    assert float(jnp.max(jnp.abs(krylov.x - direct.x))) <= 1e-9
+
+
 def test_rows_with_some_entries_fixed_are_padded():
     """Vertices with only some coordinates fixed: their free entries join a padded block."""
     import ddgjax as dg
