@@ -1,5 +1,6 @@
-"""One surface stack: one connectivity type, and no cotangent formula typed into the library
-outside the flip loop's angle criterion (the Laplacians are derived by autodiff, Thm 6.6).
+"""One surface stack: one connectivity type, and no cotangent formula typed into the library:
+the Laplacians are derived from the Dirichlet energy by autodiff (Thm 6.6), the flip loop's
+angle criterion from the same energy by polarisation (`lengths.polarised_cotangents`).
 
 Read from the syntax trees and the source of `ddgjax/`, `energies/` and `solvers/`."""
 
@@ -15,7 +16,7 @@ SOURCES = sorted(p for package in ("ddgjax", "energies", "solvers") for p in (RO
 # b² + c² − a² written out, in any of the usual spellings
 LAW_OF_COSINES = re.compile(r"\w+2 \+ \w+2 - \w+2|\w+ \* \w+ \+ \w+ \* \w+ - \w+ \* \w+|\w+\*\*2 \+ \w+\*\*2 - \w+\*\*2")
 ALLOWED = {
-    ("ddgjax/mesh/lengths.py", "corner_cotangents"),  # Lemma 7.17: the Delaunay test of new triangles
+    ("ddgjax/mesh/lengths.py", "dirichlet_form"),  # Sec 6.3: the Gram matrix of the edges, e1·e2 from lengths
     ("ddgjax/intrinsic/geometry.py", "apex"),  # Lemma 5.8: unfolding a triangle into the plane
 }
 
@@ -51,7 +52,7 @@ def test_one_connectivity_type():
     assert sorted(c for p in SOURCES for c in connectivity_classes(p)) == ["Halfedges"]
 
 
-def test_no_cotangent_formula_outside_the_angle_criterion():
+def test_no_cotangent_formula_in_the_library():
     sites = {s for p in SOURCES for s in law_of_cosines_sites(p)}
     assert sites <= ALLOWED, sites - ALLOWED
 

@@ -12,11 +12,11 @@
   flipped depth-first (a stack), so that every non-Delaunay edge is on the stack or not yet
   swept.  Every flip is one step of Fig 7.13, recorded in the history.  The test keys
   cot + tol · s of all corners and the areas of all faces are cached and updated at each flip,
-  so a test is two lookups.  The keys come from the law of cosines
-  (`ddgjax.mesh.lengths.corner_cotangents`, Lemma 7.17), those of the start as those of the
-  triangles a flip creates; the cotan weights of the result are the derived ones (the autodiff
-  Hessian of the Dirichlet energy, `ddgjax.mesh.lengths.side_cotangent_columns`, one compiled
-  call on all faces after the loop).
+  so a test is two lookups.  The keys' cotangents are read off the triangle's Dirichlet energy
+  by polarisation (`ddgjax.mesh.lengths.corner_cotangents`, compiled into the loop), those of
+  the start as those of the triangles a flip creates; the cotan weights of the result are the
+  autodiff Hessian of the same energy (`ddgjax.mesh.lengths.side_cotangent_columns`, one
+  compiled call on all faces after the loop).
 
 Surfaces with boundary (which the reference does not treat) keep their boundary edges; only
 interior edges are tested and flipped, as in libigl's `intrinsic_delaunay_triangulation`.

@@ -9,10 +9,11 @@ by `delaunay.flip_owned`, so `import ddgjax` does not load numba.
 
 The formulas are those of the rest of `intrinsic`: the test key of a halfedge is cot + tol · s
 of the angle opposite it (Prop 7.9 with the tie tolerance of `delaunay`), the cotangents of new
-triangles are `ddgjax.mesh.lengths.corner_cotangents` (Lemma 7.17), their areas Kahan's Heron
+triangles are derived from the triangle's Dirichlet energy (`ddgjax.mesh.lengths.dirichlet_form`,
+by polarisation: `polarised_cotangents`, compiled here with a compiled form), their areas Kahan's Heron
 (`ddgjax.mesh.lengths.triangle_area`), the new diagonal is read off the unfolded quadrilateral
 (`geometry.apex`, Lemma 5.8), and a flip writes the slots that `flips.flip_batch` writes.
-numba's cache is keyed on this file alone: after editing `corner_cotangents` or `apex`, touch
+numba's cache is keyed on this file alone: after editing `dirichlet_form`, `polarised_cotangents` or `apex`, touch
 this file so that the loop is compiled again.
 
 The keys of the start come from the same formulas (`start_keys`); the cotangents that the
@@ -29,13 +30,14 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..mesh.lengths import corner_cotangents as _corner_cotangents_of
+from ..mesh.lengths import dirichlet_form as _dirichlet_form_of
+from ..mesh.lengths import polarised_cotangents
 from .geometry import apex as _apex_of
 
 __all__ = ["flip_algorithm", "interleaved", "squared_sides", "start_keys"]
 
 inline = numba.njit(cache=True, inline="always")
-corner_cotangents = inline(_corner_cotangents_of)
+corner_cotangents = inline(polarised_cotangents(inline(_dirichlet_form_of)))
 apex = inline(_apex_of)
 
 
@@ -81,8 +83,8 @@ def fails_angle_test(key, halfedges, e):
 @inline
 def new_face(key, area, face, slots, x, y, z, tol):
     """Store the area of the new face with sides x, y, z on the halfedges `slots` (in order) and
-    the keys cot + tol · s of the angles opposite them (`corner_cotangents`: cot opposite x is
-    (y² + z² − x²)/4A); returns s = h(Δ)/4."""
+    the keys cot + tol · s of the angles opposite them (`corner_cotangents`, derived from the
+    Dirichlet energy); returns s = h(Δ)/4."""
     A = triangle_area(x, y, z)
     area[face] = A
     s = quarter_harmonic_index(x, y, z, A)

@@ -52,11 +52,13 @@ __all__ = [
     "corner_weights",
     "defect_from_angles",
     "dirichlet_energy",
+    "dirichlet_form",
     "edge_lengths",
     "face_harmonic_index",
     "face_side_lengths",
     "normalised",
     "padded_size",
+    "polarised_cotangents",
     "power_of_two_scale",
     "scaled_back",
     "side_cotangent_columns",
@@ -199,17 +201,48 @@ def triangle_area(a, b, c):
     return 0.25 * xp.sqrt((x + (y + z)) * (z - (x - y)) * (z + (x - y)) * (x + (y - z))) * m * m
 
 
-def corner_cotangents(a2, b2, c2, area):
-    """The angle criterion's cotangents (law of cosines over twice the area; Lemma 7.17):
+def dirichlet_form(d1, d2, a2, b2, c2):
+    """8A times the Dirichlet energy ½ ∫ |∇f|² dA of the affine function with f1 − f0 = d1 and
+    f2 − f0 = d2 on a triangle with squared sides a2, b2, c2 (opposite corners 0, 1, 2), written
+    with the Gram matrix of the edges e1 = P1 − P0, e2 = P2 − P0 (Sec 6.3), no angles:
 
-        cot α = (b² + c² − a²) / 4A,   cot β = (c² + a² − b²) / 4A,   cot γ = (a² + b² − c²) / 4A,
+        g11 = c2,  g22 = b2,  g12 = (b2 + c2 − a2) / 2,    8A · E = g22 d1² − 2 g12 d1 d2 + g11 d2².
 
-    α, β, γ the angles opposite the sides with squared lengths a2, b2, c2.  Their sum is
-    h(Δ)/4 (Lemma 7.17).  Used by the Delaunay test of the flip algorithm (Prop 7.9); the cotan
-    weights of the Laplacians come from `stiffness` (autodiff), which agrees with −½ of these.
-    """
-    inv = 0.25 / area
-    return (b2 + c2 - a2) * inv, (c2 + a2 - b2) * inv, (a2 + b2 - c2) * inv
+    The one definition of a triangle's Dirichlet energy: `dirichlet_energy` divides it by 8A and
+    its Hessian derives the cotan Laplacians (`stiffness`, by autodiff); `corner_cotangents`
+    derives the same weights from it by polarisation.  Plain arithmetic on scalars or arrays of
+    any library, so that numba compiles it into the flip loop."""
+    return b2 * d1 * d1 - (b2 + c2 - a2) * d1 * d2 + c2 * d2 * d2
+
+
+def polarised_cotangents(form):
+    """The corner cotangents of a triangle derived from `form` (`dirichlet_form`: 8A times a
+    Dirichlet energy, a quadratic form in the vertex values f): its Hessian entries are exact
+    second differences (polarisation, E(0) = 0),
+
+        K_jk = E(e_j + e_k) − E(e_j) − E(e_k),
+
+    and cot α_i = −2 K[i+1, i+2] (Thm 6.6).  A factory, so that the flip loop can compile the
+    same derivation with a numba-compiled `form` (`ddgjax.intrinsic.flip_algorithm`)."""
+
+    def corner_cotangents(a2, b2, c2, area):
+        """(cot α, cot β, cot γ): the cotangents of the angles opposite the sides with squared
+        lengths a2, b2, c2, derived from the triangle's Dirichlet energy by polarisation
+        (`polarised_cotangents`); their sum is h(Δ)/4 (Lemma 7.17).  Used by the Delaunay test
+        of the flip algorithm (Prop 7.9)."""
+
+        def q(f0, f1, f2):
+            return form(f1 - f0, f2 - f0, a2, b2, c2)
+
+        inv = -0.25 / area  # cot = −2 K, K = Q / 8A
+        return ((q(0.0, 1.0, 1.0) - q(0.0, 1.0, 0.0) - q(0.0, 0.0, 1.0)) * inv,
+                (q(1.0, 0.0, 1.0) - q(0.0, 0.0, 1.0) - q(1.0, 0.0, 0.0)) * inv,
+                (q(1.0, 1.0, 0.0) - q(1.0, 0.0, 0.0) - q(0.0, 1.0, 0.0)) * inv)
+
+    return corner_cotangents
+
+
+corner_cotangents = polarised_cotangents(dirichlet_form)
 
 
 def face_harmonic_index(a, b, c, area):
@@ -228,25 +261,14 @@ def _area_from_squares(l2):
 
 def dirichlet_energy(f: Float[Array, "3"], l2: Float[Array, "3"]) -> Float[Array, ""]:
     """Dirichlet energy ½ ∫ |∇f|² dA of the affine interpolant of the values f on one triangle,
-    written in its squared side lengths (Sec 6.3), no angles: with the edges e1 = P1 − P0,
-    e2 = P2 − P0 their Gram matrix is
-
-        g11 = l01²,  g22 = l02²,  g12 = (l01² + l02² − l12²) / 2,   √det G = 2A,
-
-    and with d = (f1 − f0, f2 − f0)
-
-        E(f) = (g22 d1² − 2 g12 d1 d2 + g11 d2²) / (4 √det G),
-
-    A by Kahan's Heron (`triangle_area`).  It equals ¼ Σ_k cot α_k (f_{k+1} − f_{k+2})² (Thm 6.6),
-    so its Hessian in f *derives* the cotan weights (`stiffness`).  `l2[k]` is the squared side
-    opposite corner k: l12² = l2[0], l02² = l2[1], l01² = l2[2].  `f` and `l2` may also be
-    triples of equally shaped arrays (one triangle per entry, `side_cotangent_columns`).
+    written in its squared side lengths (Sec 6.3), no angles: `dirichlet_form` over 8A, A by
+    Kahan's Heron (`triangle_area`).  It equals ¼ Σ_k cot α_k (f_{k+1} − f_{k+2})² (Thm 6.6), so
+    its Hessian in f *derives* the cotan weights (`stiffness`).  `l2[k]` is the squared side
+    opposite corner k.  `f` and `l2` may also be triples of equally shaped arrays (one triangle
+    per entry, `side_cotangent_columns`).
     """
-    g11, g22 = l2[2], l2[1]
-    g12 = 0.5 * (l2[2] + l2[1] - l2[0])
-    d1, d2 = f[1] - f[0], f[2] - f[0]
     area = triangle_area(jnp.sqrt(l2[0]), jnp.sqrt(l2[1]), jnp.sqrt(l2[2]))
-    return (g22 * d1 * d1 - 2.0 * g12 * d1 * d2 + g11 * d2 * d2) / (8.0 * area)
+    return dirichlet_form(f[1] - f[0], f[2] - f[0], l2[0], l2[1], l2[2]) / (8.0 * area)
 
 
 def _stiffness(l2):
