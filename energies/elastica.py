@@ -48,14 +48,16 @@ import numpy as np
 from jaxtyping import Array, Float
 
 import ddgjax as dg
-from ddgjax._checks import check_positive, checked_count, checked_shape, concrete_value, when_concrete
+from ddgjax._checks import check_positive, checked_count, checked_shape, concrete_value, is_concrete, when_concrete
 from ddgjax.errors import InvalidInputError, NonFiniteError
 
 __all__ = [
     "bending_density",
     "bending_energy",
     "clamped",
+    "clamped_bending",
     "closed",
+    "loaded",
     "load",
     "resample",
     "great_circle",
@@ -342,21 +344,85 @@ def clamped(
     chord = checked_chord(chord, length)
     t_start, t_end = unit_vector(t_start, "t_start"), unit_vector(t_end, "t_end")
     T0 = starting_array(x0, lambda: initial_tangents(n, length, chord, t_start, t_end), (n, 3))
-    edges = np.arange(n)
-    energy = dg.local_sum(_bend, np.stack([edges[:-1], edges[1:]], axis=1))
-    fixed = np.zeros((n, 3), bool)
-    if clamp == "edge":
-        T0, fixed = clamp_ends(T0, t_start, t_end)
-        free_edges = edges[1:-1]
-    else:
-        energy = energy + dg.local_sum(_ghost_bend, np.array([[0], [n - 1]]), data=np.array([0, 1]))
-        free_edges = edges
+    energy, T0, fixed, free_edges = clamped_bending(n, T0, t_start, t_end, clamp)
     constraints = unit_and_chord(free_edges, n)
     params = {"h": length / n, "chord": chord, "t_start": t_start, "t_end": t_end}
     return dg.Problem(
         energy, T0, constraints=constraints, params=params, fixed=fixed,
         name=f"clamped elastica (n={n}, clamp={clamp})",
     )
+
+
+def clamped_bending(n: int, T0, t_start, t_end, clamp: str):
+    """`(energy, T0, fixed, free_edges)` of the clamped bending energy (2/h) Σ E_k (module
+    docstring, Clamps): `clamp="edge"` fixes T_0 = t_start and T_{n−1} = t_end in T0,
+    `clamp="vertex"` adds the half-weight ghost-edge terms at the end vertices instead."""
+    edges = np.arange(n)
+    energy = dg.local_sum(_bend, np.stack([edges[:-1], edges[1:]], axis=1))
+    fixed = np.zeros((n, 3), bool)
+    if clamp == "edge":
+        T0, fixed = clamp_ends(T0, t_start, t_end)
+        return energy, T0, fixed, edges[1:-1]
+    energy = energy + dg.local_sum(_ghost_bend, np.array([[0], [n - 1]]), data=np.array([0, 1]))
+    return energy, T0, fixed, edges
+
+
+def _load_potential(T1, p):
+    return p["load"] * p["h"] * jnp.dot(T1[0], p["t_start"])
+
+
+def _lateral(T1, p):
+    return p["h"] * (p["across"] @ T1[0])
+
+
+def loaded(n: int, *, load: float = 0.0, length: float = 1.0, direction=(1.0, 0.0, 0.0), clamp: str = "vertex",
+           x0=None) -> dg.Problem:
+    """Euler's column: a discrete elastica clamped straight at both ends along the unit vector
+    d = `direction` and compressed by an end load P = `load`: n unit edge tangents T (n, 3),
+    critical points of
+
+        (2/h) Σ_k E_k + P h Σ_k ⟨T_k, d⟩     on {|T_k| = 1, h Σ_k ⟨T_k, e⟩ = 0 for e ⊥ d},
+
+    the clamped bending energy of `clamped` (`clamp="vertex"`: the end vertex tangents are d,
+    O(h²); `"edge"`: T_0 = T_{n−1} = d) plus the potential of the load, P times the chord's
+    length along d (its work is −P times the shortening).  Constraint `"lateral"` (2,) keeps the
+    far end on the load's line (the chord's components across d vanish); the chord's length is
+    free: P is prescribed, where `clamped` prescribes the chord and returns the load as its
+    multiplier.
+
+    The straight column T_k = d is critical for every P (unit multipliers P h/2, so the reduced
+    Hessian is that of the bending energy minus P h); it is stable up to the first discrete
+    Euler load P₁ and loses stability there without a fold, in a bifurcation whose critical
+    eigenvalue is double (the column buckles in any plane through d: the index jumps by 2).
+    `solvers.continuation` in `load` reports it (`Branch.bifurcations`); P₁ → 4π²/L² (the
+    smooth clamped–clamped Euler load of ½∫κ², Euler 1744).
+
+    Constraints `{"lateral": (2,), "unit": (m,)}`; params `{"h", "load", "t_start", "t_end",
+    "across"}` (the clamps are d; `across` (2, 3) the unit vectors ⊥ d).  Differentiable in
+    `load`.  The default start is the straight column.
+
+    **Raises:** `InvalidInputError` for n < 3, a length that is not finite and positive, a zero
+    direction, an unknown clamp, a non-finite load; `ShapeError`, `NonFiniteError` as `clamped`.
+    """
+    n = checked_count(n, 3, "n, the number of edges of Euler's column,")
+    if clamp not in ("edge", "vertex"):
+        raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
+    length = checked_length(length)
+    d = unit_vector(direction, "direction")
+    if is_concrete(load) and not np.all(np.isfinite(np.asarray(load, dtype=float))):
+        raise InvalidInputError(f"load must be finite, got {load!r}")
+    e1 = _perpendicular(d, jnp)
+    across = jnp.stack([e1, jnp.cross(d, e1)])
+    T0 = starting_array(x0, lambda: jnp.tile(d, (n, 1)), (n, 3))
+    energy, T0, fixed, free_edges = clamped_bending(n, T0, d, d, clamp)
+    energy = energy + dg.local_sum(_load_potential, np.arange(n)[:, None])
+    constraints = dg.concat(
+        unit=dg.local_map(_unit, free_edges[:, None]),
+        lateral=dg.local_sum(_lateral, np.arange(n)[:, None]),
+    )
+    params = {"h": length / n, "load": jnp.asarray(load, dtype=float), "t_start": d, "t_end": d, "across": across}
+    return dg.Problem(energy, T0, constraints=constraints, params=params, fixed=fixed,
+                      name=f"Euler's column (n={n}, clamp={clamp})")
 
 
 def closed(n: int, *, length: float = 1.0, x0) -> dg.Problem:

@@ -9,6 +9,7 @@ parameters in one call, vectorised and sharded over devices.  This package knows
 import ddgjax as _ddgjax  # noqa: F401  (switches on float64 before anything is traced)
 
 from ._batch import solve_batch as solve_batch
+from ._continuation import Bifurcation as Bifurcation
 from ._continuation import Branch as Branch
 from ._continuation import continuation as continuation
 from ._dense import DenseLU as DenseLU
@@ -23,4 +24,4 @@ from ._stability import Stability as Stability
 from ._stability import stability as stability
 
 __all__ = ["solve", "minimize", "solve_batch", "Solution", "LinearSolver", "DenseLU", "KLU", "SparseDirect", "Krylov",
-           "stability", "Stability", "continuation", "Branch"]
+           "stability", "Stability", "continuation", "Branch", "Bifurcation"]

@@ -42,6 +42,16 @@ consecutive points; it is refined to `|dp/ds| ≤ 1e-10` by the Illinois (regula
 the predictor distance σ ∈ [0, Δs] from the earlier point (each trial a corrector and a tangent).
 At a generic fold one eigenvalue of the reduced Hessian crosses zero: the Morse index
 (`solvers.stability`, the second-order condition of Sec 3.1) changes by one there.
+
+**Bifurcations.**  Where the index changes between two consecutive points and `dp/ds` keeps its
+sign, an eigenvalue of the reduced Hessian crosses zero while the branch goes on: a simple
+bifurcation point (pitchfork or transcritical; e.g. Euler buckling of a straight rod under an
+end load), where a second branch of critical points crosses this one in the direction of the
+critical eigenvector.  The pseudo-arclength steps pass over it (the bordered Jacobian is
+singular only at the point itself); it is refined by the same Illinois iteration on σ, now on the
+crossing eigenvalue (the j-th lowest, j the smaller index of the two points) until it is
+`≤ BIFURCATION_TOL` times the eigenvalues' scale (`Stability.scale`), and reported with its
+eigenvector (`Bifurcation.mode`), the direction of the other branch.
 """
 
 from __future__ import annotations
@@ -61,7 +71,7 @@ from ._kkt import KKT, residual_weights, scaled_residual, spec_of
 from ._solve import Solution, linear_solver_of, solve
 from ._stability import stability
 
-__all__ = ["Branch", "Fold", "IndexChange", "continuation"]
+__all__ = ["Bifurcation", "Branch", "Fold", "IndexChange", "continuation"]
 
 GROW, SHRINK = 1.5, 0.7  # step-length factors after an easy (≤ EASY steps) or a hard (≥ HARD) corrector
 EASY, HARD = 3, 6
@@ -69,6 +79,7 @@ MAX_TURN = np.cos(np.pi / 6)  # successive tangents must agree to 30°
 MAX_CORRECTION = 0.5  # the corrector may move at most this fraction of Δs from the predictor
 FOLD_TOL = 1e-10  # |dp/ds| at a refined fold
 FOLD_ITERATIONS = 60
+BIFURCATION_TOL = 1e-10  # |crossing eigenvalue| / Stability.scale at a refined bifurcation
 FD_STEP = 1e-5  # central differences of (z0, params) in p, relative to max(1, |p|)
 
 
@@ -101,6 +112,31 @@ class IndexChange(NamedTuple):
     p: float
 
 
+class Bifurcation(NamedTuple):
+    """A simple bifurcation point of the branch (module docstring): the Morse index changes from
+    `before` (point `after`) to `after_index` (point `after + 1`) with no fold between them.
+
+    - `p`, `x`, `multipliers`, `energy`, `residual`: the critical point where the crossing
+      eigenvalue vanishes; `s`: its pseudo-arclength.
+    - `eigenvalue`: the crossing eigenvalue of the reduced Hessian there (≈ 0); `mode`: its
+      eigenvector as a pytree like x (zero on fixed entries): the direction of the other branch.
+    - `refined`: False when the refinement failed (the point is then the nearer of the two).
+    """
+
+    p: float
+    x: object
+    multipliers: object
+    energy: float
+    residual: float
+    s: float
+    eigenvalue: float
+    mode: object
+    after: int
+    before: int
+    after_index: int
+    refined: bool
+
+
 class Branch(NamedTuple):
     """The result of `continuation`: K points along the branch, in order of arclength.
 
@@ -111,7 +147,8 @@ class Branch(NamedTuple):
     - `s` (K,): pseudo-arclength (weighted norm, module docstring); `dp_ds` (K,): the unit
       tangent's p-component (its sign says whether the branch moves towards p1).
     - `steps` (K,): Newton steps of each corrector (of `solve` for the first point).
-    - `folds`: the turning points found (`Fold`); `index_changes`: `IndexChange`s between points.
+    - `folds`: the turning points found (`Fold`); `index_changes`: `IndexChange`s between points;
+      `bifurcations`: the index changes that no fold explains (`Bifurcation`, refined).
     - `stopped`: why the continuation ended: `"reached p1"`, `"returned to p0"`, `"max_points"`
       or `"step too small at p = …"`.
     """
@@ -128,6 +165,7 @@ class Branch(NamedTuple):
     folds: tuple
     index_changes: tuple
     stopped: str
+    bifurcations: tuple = ()
 
     def solution(self, i: int) -> Solution:
         """Point i as a `Solution` of `problem_of(p[i])` (e.g. for `solvers.stability`)."""
@@ -451,31 +489,39 @@ def _crossed(p, p0, p1, direction) -> tuple[float, str] | None:
     return None
 
 
-def _refine_fold(tracer: _Tracer, a: _Point, b: _Point) -> tuple[_Point, bool]:
-    """The point between a and b where the tangent's p-component vanishes: Illinois on the
-    predictor distance σ from a (module docstring)."""
+def _illinois(tracer: _Tracer, a: _Point, b: _Point, f, f_a: float, f_b: float, tol: float):
+    """`(point, f there, refined)`: the point between a and b where `f(point)` (opposite signs
+    `f_a`, `f_b` at a and b) vanishes to `tol`, by the Illinois (regula-falsi) method on the
+    predictor distance σ ∈ [0, Δs] from a, each trial a corrector (module docstring)."""
     lo, hi = 0.0, float(a.t @ (tracer.S * (b.y - a.y)))
-    f_lo, f_hi = a.t[-1], b.t[-1]
-    best = a if abs(f_lo) <= abs(f_hi) else b
+    f_lo, f_hi = f_a, f_b
+    best, f_best = (a, f_a) if abs(f_a) <= abs(f_b) else (b, f_b)
     side = 0
     for _ in range(FOLD_ITERATIONS):
         sigma = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
         trial = tracer.correct(a.y + sigma * a.t / tracer.S, a.t * tracer.S, a.t)
         if trial is None:
-            return best, False
-        f = trial.t[-1]
-        best = trial if abs(f) < abs(best.t[-1]) else best
-        if abs(f) <= FOLD_TOL or hi - lo <= 1e-14 * max(1.0, hi):
-            return best, abs(best.t[-1]) <= FOLD_TOL
-        if np.sign(f) == np.sign(f_lo):
-            lo, f_lo = sigma, f
+            return best, f_best, False
+        value = f(trial)
+        if abs(value) < abs(f_best):
+            best, f_best = trial, value
+        if abs(value) <= tol or hi - lo <= 1e-14 * max(1.0, hi):
+            return best, f_best, abs(f_best) <= tol
+        if np.sign(value) == np.sign(f_lo):
+            lo, f_lo = sigma, value
             f_hi = f_hi * 0.5 if side == -1 else f_hi
             side = -1
         else:
-            hi, f_hi = sigma, f
+            hi, f_hi = sigma, value
             f_lo = f_lo * 0.5 if side == 1 else f_lo
             side = 1
-    return best, abs(best.t[-1]) <= FOLD_TOL
+    return best, f_best, abs(f_best) <= tol
+
+
+def _refine_fold(tracer: _Tracer, a: _Point, b: _Point) -> tuple[_Point, bool]:
+    """The point between a and b where the tangent's p-component vanishes."""
+    fold, _, refined = _illinois(tracer, a, b, lambda point: point.t[-1], a.t[-1], b.t[-1], FOLD_TOL)
+    return fold, refined
 
 
 def _report(family, tracer, points, ds_used, steps0, stopped, with_index, refine_folds) -> Branch:
@@ -489,10 +535,12 @@ def _report(family, tracer, points, ds_used, steps0, stopped, with_index, refine
     folds = tuple(_fold(family, tracer, points, s, i, refine_folds) for i in turns)
     changes = tuple(IndexChange(int(i), int(index[i]), int(index[i + 1]), float(p[i + 1]))
                     for i in range(len(points) - 1) if min(index[i], index[i + 1]) >= 0 and index[i] != index[i + 1])
+    bifurcations = tuple(_bifurcation(family, tracer, points, s, change, refine_folds)
+                         for change in changes if change.after not in set(turns.tolist()))
     x, multipliers, energy = (stack([st[0] for st in states]), stack([st[1] for st in states]),
                               np.array([st[2] for st in states]))
     return Branch(p, x, multipliers, energy, residual, index, s, np.array([pt.t[-1] for pt in points]),
-                  np.array([steps0] + [pt.steps for pt in points[1:]]), folds, changes, stopped)
+                  np.array([steps0] + [pt.steps for pt in points[1:]]), folds, changes, stopped, bifurcations)
 
 
 def _sign_changes(values) -> np.ndarray:
@@ -501,14 +549,35 @@ def _sign_changes(values) -> np.ndarray:
     return np.flatnonzero(values[:-1] * values[1:] < 0)
 
 
+def _stability_at(family, point: _Point, k: int):
+    """`solvers.stability` of the branch's point (by inertia on the sparse path)."""
+    x, multipliers, energy = family.point(point.y)
+    sol = _solution(x, multipliers, energy, point.residual, point.steps)
+    return stability(family.problem(float(point.y[-1])), sol, k=k, method="sparse" if family.spec.is_local else "dense")
+
+
 def _morse_indices(family, points, states) -> np.ndarray:
-    """`solvers.stability`'s index at every point (by inertia on the sparse path: no eigh)."""
-    method = "sparse" if family.spec.is_local else "dense"
-    index = np.empty(len(points), dtype=int)
-    for i, (pt, (x, multipliers, energy)) in enumerate(zip(points, states)):
-        sol = _solution(x, multipliers, energy, pt.residual, pt.steps)
-        index[i] = stability(family.problem(float(pt.y[-1])), sol, k=1, method=method).index
-    return index
+    """`solvers.stability`'s index at every point."""
+    return np.array([_stability_at(family, pt, 1).index for pt in points], dtype=int)
+
+
+def _bifurcation(family, tracer, points, s, change: IndexChange, refine: bool) -> Bifurcation:
+    """The bifurcation between points `change.after` and `change.after + 1`: where the j-th
+    lowest eigenvalue of the reduced Hessian, j = the smaller index, crosses zero."""
+    i, j = change.after, min(change.before, change.after_index)
+    a, b = points[i], points[i + 1]
+    crossing = lambda point: float(_stability_at(family, point, j + 1).eigenvalues[j])
+    at_a = _stability_at(family, a, j + 1)
+    f_a, f_b = float(at_a.eigenvalues[j]), crossing(b)
+    if refine and np.sign(f_a) != np.sign(f_b):
+        point, _, refined = _illinois(tracer, a, b, crossing, f_a, f_b, BIFURCATION_TOL * at_a.scale)
+    else:
+        point, refined = (a if abs(f_a) <= abs(f_b) else b), False
+    at = _stability_at(family, point, j + 1)
+    x, multipliers, energy = family.point(point.y)
+    arclength = float(s[i] + a.t @ (tracer.S * (point.y - a.y)))
+    return Bifurcation(float(point.y[-1]), x, multipliers, energy, point.residual, arclength,
+                       float(at.eigenvalues[j]), at.mode(j), int(i), change.before, change.after_index, bool(refined))
 
 
 def _fold(family, tracer, points, s, i, refine: bool) -> Fold:

@@ -74,6 +74,32 @@ def test_monotone_branch_reaches_p1_exactly_without_folds():
     assert branch.folds == () and branch.index_changes == () and np.all(branch.index == 0)
 
 
+def _pitchfork(x, params):
+    return 0.25 * x[0] ** 4 + 0.5 * (1.0 - params["p"]) * x[0] ** 2
+
+
+def test_pitchfork_is_a_bifurcation_refined_to_the_zero_eigenvalue():
+    """E = x⁴/4 + (1 − p) x²/2: x = 0 is critical for every p with Hessian 1 − p, so the
+    index changes 0 → 1 at p = 1 while the branch goes on (dp/ds > 0 throughout): one
+    bifurcation, at p = 1, eigenvalue 0, mode ±e₁ (where x = ±√(p − 1) leaves); no fold."""
+    problem_of = lambda p: dg.Problem(_pitchfork, jnp.zeros(1), params={"p": p})
+    branch = solvers.continuation(problem_of, 0.3, 1.8, ds=0.25)
+    assert branch.stopped == "reached p1" and branch.folds == () and np.all(branch.dp_ds > 0)
+    (change,) = branch.index_changes
+    (bif,) = branch.bifurcations
+    assert (bif.before, bif.after_index, bif.after) == (0, 1, change.after) and bif.refined
+    assert abs(bif.p - 1.0) <= 1e-9 and abs(bif.eigenvalue) <= 1e-9
+    assert abs(abs(float(bif.mode[0])) - 1.0) <= 1e-12 and abs(float(bif.x[0])) <= 1e-12
+
+
+def test_a_fold_is_not_a_bifurcation():
+    """Negative control: at the fold of E = x³/3 + (p − 1)x the index changes too, but the fold
+    explains it: no bifurcation is reported."""
+    problem_of = lambda p: dg.Problem(_numpy_energy, jnp.array([1.0]), params=jnp.array([p]))
+    branch = solvers.continuation(problem_of, 0.0, 2.0)
+    assert len(branch.folds) == 1 and len(branch.index_changes) == 1 and branch.bifurcations == ()
+
+
 def _quadratic(x, params):
     return 0.5 * x[0] ** 2 - params["p"] * x[0]
 

@@ -15,6 +15,12 @@ followed in its chord c·e1.  Every chord c < 1 forces the curve to bend (`clamp
 the branch turns back (a fold in c: the pitchfork of the buckled shape and its mirror image,
 meeting at the straight rod) and the chord multiplier (the load of Thm 3.2's `T'' = cT + a`)
 is the critical load: 4π² for the smooth column of bending energy ½∫κ² clamped at both ends.
+
+Euler's column: the same rod with the load prescribed instead of the chord
+(`energies.elastica.loaded`), followed in the load.  The straight column is critical for every
+load; at the discrete Euler load an eigenvalue of its second variation crosses zero without a
+fold, a bifurcation (`solvers.continuation`'s `Branch.bifurcations`), from which the buckled
+branch of the chord-controlled problem leaves.
 """
 
 from __future__ import annotations
@@ -125,15 +131,18 @@ def _scalar_energy(x, params):
 
 
 @check("Keller 1977", "the scalar fold x² + p − 1 = 0 (critical points of x³/3 + (p − 1)x) is found at p = 1, x = 0, "
-       "and the branch returns to p = 0 at x = −1 with index 1",
-       quantity="|p_fold − 1| + |x_fold| + |x_end + 1| + |index_end − 1|", at_most=1e-9, quick=dict(ds=0.05))
+       "and the branch returns to p = 0 at x = −1 with index 1; the fold explains the index change, so no "
+       "bifurcation is reported (the negative control of the bifurcation checks below)",
+       quantity="|p_fold − 1| + |x_fold| + |x_end + 1| + |index_end − 1| + #bifurcations", at_most=1e-9,
+       quick=dict(ds=0.05))
 def scalar_fold(ctx, ds):
     branch = continuation(scalar_problem_of, 0.0, 2.0, ds=ds)
     if len(branch.folds) != 1:
         return float("inf")
     fold = branch.folds[0]
     end = branch.x[-1, 0]
-    return abs(fold.p - 1.0) + abs(float(fold.x[0])) + abs(end + 1.0) + abs(branch.index[-1] - 1)
+    return (abs(fold.p - 1.0) + abs(float(fold.x[0])) + abs(end + 1.0) + abs(branch.index[-1] - 1)
+            + len(branch.bifurcations))
 
 
 # --- Euler buckling: the clamped elastica followed in its chord ---------------------------------
@@ -252,3 +261,65 @@ def elastica_buckled_load_order(ctx, ns):
                             title="buckled elastica: max |λ(c)/a(c) − 1| against n")
     return float(table.fitted_order)
 
+
+# --- Euler's column: the straight elastica followed in its end load ------------------------------
+
+LOAD_START, LOAD_END = 30.0, 45.0  # below the first discrete Euler load at n ≥ 8 (37.49), beyond 4π²
+
+
+@functools.cache
+def column_branch(n: int):
+    """`energies.elastica.loaded(n)` (vertex clamps along e1, length 1) followed in its load from
+    P = 30 to 45: the straight column throughout."""
+    base = elastica.loaded(n)
+    return continuation(lambda P: base.with_params({**base.params, "load": P}), LOAD_START, LOAD_END, ds=3.0)
+
+
+def column_bifurcation_load(n: int) -> float:
+    """The load of the one refined bifurcation of `column_branch(n)` (inf if there is not exactly one)."""
+    branch = column_branch(n)
+    if len(branch.bifurcations) != 1 or not branch.bifurcations[0].refined:
+        return float("inf")
+    return branch.bifurcations[0].p
+
+
+def buckling_mode_defect(n: int) -> float:
+    """1 − |cos| of the angle between the bifurcation's mode and the buckling mode: the mode's
+    components across the load, θ_k ∈ R² (any plane through e1 buckles alike), against
+    sin(2π(k + ½)h) v, v their best direction (the mode's rank-one fit)."""
+    bif = column_branch(n).bifurcations[0]
+    theta = np.asarray(bif.mode)[:, 1:]  # across e1: the e2 and e3 components
+    s = np.sin(2.0 * np.pi * (np.arange(n) + 0.5) / n)
+    fit = np.linalg.norm(s @ theta) / (np.linalg.norm(s) * np.linalg.norm(theta))
+    return float(1.0 - fit)
+
+
+@check("Euler 1744; Thm 3.2, Def 3.2", "Euler's column: the straight discrete elastica (vertex clamps along e1, "
+       "L = 1) under an end load P, followed in P, stays critical and loses stability without a fold, in a "
+       "bifurcation (`Branch.bifurcations`) at the discrete Euler load λ_h = (2 sin(πh)/h)², with the Morse index "
+       "jumping 0 → 2 (both buckling planes) and the critical mode θ_k ∝ sin(2π(k + ½)h)",
+       quantity="|P_bif/λ_h − 1| + |index jump − 2| + #folds + (1 − |cos(mode, sin mode)|)", at_most=1e-8,
+       quick=dict(n=16), full=dict(n=64))
+def euler_column_bifurcation(ctx, n):
+    branch = column_branch(n)
+    if len(branch.bifurcations) != 1:
+        return float("inf")
+    bif = branch.bifurcations[0]
+    return (abs(column_bifurcation_load(n) / discrete_euler_load(n) - 1.0) + abs(bif.after_index - bif.before - 2)
+            + len(branch.folds) + buckling_mode_defect(n))
+
+
+@check("Euler 1744; Thm 3.2, Def 3.2", "the column's bifurcation load converges to Euler's critical load 4π² of "
+       "the clamped–clamped column (bending energy ½∫κ², L = 1) at second order",
+       quantity="fitted order of |P_bif(n) − 4π²|", target=2.0, within=0.1, quick=dict(ns=(8, 16, 32)),
+       full=dict(ns=(8, 16, 32, 64, 128)))
+def euler_column_load_order(ctx, ns):
+    table = ctx.convergence(dg.limits.convergence(lambda n: abs(column_bifurcation_load(n) - EULER_LOAD), list(ns)),
+                            "euler_column_load_order", title="Euler's column: |P_bif − 4π²| against n")
+    return float(table.fitted_order)
+
+
+@check("Euler 1744; Thm 3.2, Def 3.2", "negative control: the column's bifurcation load is not the pinned–pinned "
+       "column's π² but four times it", quantity="|P_bif/π² − 1|", at_least=2.5, quick=dict(n=16), full=dict(n=64))
+def euler_column_not_pinned(ctx, n):
+    return abs(column_bifurcation_load(n) / PINNED_LOAD - 1.0)
