@@ -54,7 +54,7 @@ from jaxtyping import Array, Float
 import ddgjax as dg
 from ddgjax import frames
 from ddgjax import quaternion as qt
-from ddgjax._checks import check_finite, checked_count, checked_shape, when_concrete
+from ddgjax._checks import check_finite, checked_count, checked_shape, is_concrete, when_concrete
 from ddgjax.errors import InvalidInputError
 
 from .elastica import (
@@ -62,7 +62,7 @@ from .elastica import (
 )
 
 __all__ = [
-    "clamped", "anisotropic_bending_density", "tangents", "twist_angles", "curve", "load", "ClampMismatchError",
+    "clamped", "loaded", "twisted_frame", "anisotropic_bending_density", "tangents", "twist_angles", "curve", "load", "ClampMismatchError",
 ]
 
 
@@ -251,6 +251,60 @@ def clamped(
     return dg.Problem(
         energy, Phi0, constraints=constraints, params=params, fixed=fixed, name=f"clamped rod (n={n}, clamp={clamp})"
     )
+
+
+def _load_potential(Phi1, p):
+    return p["load"] * p["h"] * qt.rotate(Phi1[0], E1)[0]
+
+
+def _lateral(Phi1, p):
+    return p["h"] * qt.rotate(Phi1[0], E1)[1:]
+
+
+def twisted_frame(angle):
+    """The unit quaternion of the rotation by `angle` about e1: the end frame of a column
+    twisted by `angle` (its tangent stays e1)."""
+    half = 0.5 * jnp.asarray(angle, dtype=float)
+    return jnp.stack([jnp.cos(half), jnp.sin(half), 0.0 * half, 0.0 * half])
+
+
+def loaded(n: int, *, alpha: float, twist: float = 0.0, load: float = 0.0, length: float = 1.0,
+           clamp: str = "vertex", x0=None) -> dg.Problem:
+    """A twisted column (Greenhill 1883): the rod of `clamped` along e1, its start frame the
+    identity and its end frame turned by ψ = `twist` about e1 (`twisted_frame`), under an end
+    load P = `load` (compressive along e1); critical points of
+
+        rod energy (module docstring) + P h Σ_k ⟨T_k, e1⟩    on {|Φ_k| = 1, h Σ_k T_k ⊥ e1},
+
+    as `energies.elastica.loaded` (constraint `"lateral"` (2,): the far end stays on the axis;
+    the axial chord is free).  The straight column with uniform twist, Φ_k the rotation by
+    ψ s_k/L about e1 (s_k the edge midpoints; the default start), is critical for every (ψ, P):
+    a twisting moment M = αψ/L and the load P act on it.  It loses stability in a bifurcation
+    into a helical mode (the index jumps by 2: the mode and its turn about the axis): with P = 0
+    at M L = 2ξ (bending stiffness 1), ξ the first positive root of tan ξ = ξ, M L ≈ 8.9868
+    (Zajac 1962: the lateral displacement w = x + iy of the linearised rod solves w⁗ = iM w‴ with
+    w = w′ = 0 at both ends), and with ψ = 0 at P = 4π²/L² (Euler).
+    `solvers.continuation` in `twist` (`params["frame_end"] = twisted_frame(ψ)`) or in `load`
+    reports it.
+
+    Constraints `{"lateral": (2,), "unit": (m,)}`; params as `clamped` (without the chord) and
+    `"load"`.  **Raises:** as `clamped`, and `InvalidInputError` for a non-finite twist or load.
+    """
+    for value, name in ((twist, "twist"), (load, "load")):
+        if is_concrete(value) and not np.all(np.isfinite(np.asarray(value, dtype=float))):
+            raise InvalidInputError(f"{name} must be finite, got {value!r}")
+    q0, q1 = twisted_frame(0.0), twisted_frame(twist)
+    s = (np.arange(n) + 0.5) / max(int(n), 1) if clamp == "vertex" else np.linspace(0.0, 1.0, max(int(n), 1))
+    column = jnp.stack([twisted_frame(twist * t) for t in s]) if isinstance(n, (int, np.integer)) and n >= 3 else None
+    base = clamped(n, alpha=alpha, length=length, chord=(0.5 * length, 0.0, 0.0), frame_start=q0, frame_end=q1,
+                   clamp=clamp, x0=column if x0 is None else x0)
+    edges = np.arange(n)
+    energy = base.energy + dg.local_sum(_load_potential, edges[:, None])
+    free_edges = edges[1:-1] if clamp == "edge" else edges
+    constraints = dg.concat(unit=dg.local_map(_unit, free_edges[:, None]), lateral=dg.local_sum(_lateral, edges[:, None]))
+    params = {k: v for k, v in base.params.items() if k != "chord"} | {"load": jnp.asarray(load, dtype=float)}
+    return dg.Problem(energy, base.x0, constraints=constraints, params=params, fixed=base.fixed,
+                      name=f"twisted column (n={n}, clamp={clamp})")
 
 
 def tangents(Phi) -> jnp.ndarray:

@@ -117,3 +117,30 @@ def test_remark_3_16_bad_bending_raises():
             _twisted(10, bending=bad)
     with pytest.raises(ShapeError, match="bending"):
         _twisted(10, bending=(1.0, 2.0, 3.0))
+
+
+def test_twisted_column_is_critical_with_uniform_twist():
+    """`rod.loaded`: the straight column with the end twist ψ spread uniformly (θ_k = ψ/n at every
+    vertex, the ghost vertices included) is critical at any twist and load: `solve` from it takes
+    no step, and the lateral multipliers vanish.  A start off the column converges back to it
+    below the critical twist (no other critical point nearby)."""
+    problem = rod.loaded(12, alpha=1.3, twist=2.0, load=5.0)
+    sol = solve(problem)
+    assert int(sol.steps) == 0 and float(sol.residual) <= 1e-12
+    np.testing.assert_allclose(np.asarray(rod.twist_angles(sol.x)), 2.0 / 12, rtol=1e-12)
+    np.testing.assert_allclose(np.asarray(rod.tangents(sol.x)), np.tile([1.0, 0.0, 0.0], (12, 1)), atol=1e-14)
+    assert np.max(np.abs(np.asarray(sol.multipliers["lateral"]))) <= 1e-12
+    kicked = np.asarray(problem.x0) + 0.02 * np.random.default_rng(0).normal(size=(12, 4))
+    back = solve(problem.with_x0(jnp.asarray(kicked / np.linalg.norm(kicked, axis=1, keepdims=True))))
+    np.testing.assert_allclose(np.asarray(rod.tangents(back.x)), np.tile([1.0, 0.0, 0.0], (12, 1)), atol=1e-9)
+
+
+def test_twisted_column_bad_input():
+    with pytest.raises(InvalidInputError, match="twist"):
+        rod.loaded(10, alpha=1.0, twist=float("nan"))
+    with pytest.raises(InvalidInputError, match="load"):
+        rod.loaded(10, alpha=1.0, load=float("inf"))
+    with pytest.raises(InvalidInputError, match="alpha"):
+        rod.loaded(10, alpha=0.0)
+    with pytest.raises(InvalidInputError, match="n"):
+        rod.loaded(2, alpha=1.0)

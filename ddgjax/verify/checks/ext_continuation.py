@@ -20,7 +20,9 @@ Euler's column: the same rod with the load prescribed instead of the chord
 (`energies.elastica.loaded`), followed in the load.  The straight column is critical for every
 load; at the discrete Euler load an eigenvalue of its second variation crosses zero without a
 fold, a bifurcation (`solvers.continuation`'s `Branch.bifurcations`), from which the buckled
-branch of the chord-controlled problem leaves.
+branch of the chord-controlled problem leaves.  The twisted column (`energies.rod.loaded`,
+Greenhill 1883, Zajac 1962): the straight rod followed in the twist ψ of its end frame; it
+bifurcates into a helix where the twisting moment reaches M L = 2ξ, tan ξ = ξ.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ from scipy.special import ellipe, ellipk
 
 import ddgjax as dg
 from ddgjax.verify import check
-from energies import area, elastica
+from energies import area, elastica, rod
 from solvers import continuation
 
 H_START = 0.45  # the branch starts on the stable catenoid at this half-distance
@@ -323,3 +325,56 @@ def euler_column_load_order(ctx, ns):
        "column's π² but four times it", quantity="|P_bif/π² − 1|", at_least=2.5, quick=dict(n=16), full=dict(n=64))
 def euler_column_not_pinned(ctx, n):
     return abs(column_bifurcation_load(n) / PINNED_LOAD - 1.0)
+
+
+# --- the twisted column: the straight rod followed in its end twist -------------------------------
+
+TWIST_START, TWIST_END = 7.0, 11.0  # below the critical twist at n ≥ 8 (9.94), beyond Zajac's 8.99 (α = 1)
+
+
+def zajac_twist() -> float:
+    """ψ* = 2ξ (α = 1, L = 1), ξ the first positive root of tan ξ = ξ: the critical twist of the
+    clamped rod without load, M L = 2ξ ≈ 8.9868 (Zajac 1962; `energies.rod.loaded`)."""
+    return 2.0 * brentq(lambda x: np.tan(x) - x, 4.0, 4.6)
+
+
+@functools.cache
+def twisted_branch(n: int):
+    """`energies.rod.loaded(n, alpha=1)` (vertex clamps) followed in its end twist ψ from 7 to 11."""
+    base = rod.loaded(n, alpha=1.0, twist=TWIST_START)
+    return continuation(lambda psi: base.with_params({**base.params, "frame_end": rod.twisted_frame(psi)}),
+                        TWIST_START, TWIST_END, ds=2.0)
+
+
+def critical_twist(n: int) -> float:
+    """The twist of the one refined bifurcation of `twisted_branch(n)` with index jump 2, no fold
+    (inf otherwise)."""
+    branch = twisted_branch(n)
+    if len(branch.bifurcations) != 1 or branch.folds or not branch.bifurcations[0].refined:
+        return float("inf")
+    bif = branch.bifurcations[0]
+    return bif.p if (bif.before, bif.after_index) == (0, 2) else float("inf")
+
+
+@check("Zajac 1962; Thm 3.13, Def 3.7", "the twisted column: the straight discrete rod (α = 1, vertex clamps, "
+       "L = 1, no load) followed in its end twist ψ stays critical and loses stability without a fold, in a "
+       "bifurcation (index 0 → 2) at Zajac's critical twist ψ* = 2ξ ≈ 8.9868 (tan ξ = ξ) up to O(h²): the relative "
+       "error times n² is about 6.8 at n = 8 and 6.1 at n = 32", quantity="n² |ψ_bif/ψ* − 1|", at_most=8.0,
+       quick=dict(n=8), full=dict(n=32))
+def twisted_column_bifurcation(ctx, n):
+    return n * n * abs(critical_twist(n) / zajac_twist() - 1.0)
+
+
+@check("Zajac 1962; Thm 3.13, Def 3.7", "the twisted column's critical twist converges to Zajac's ψ* = 2ξ at second "
+       "order", quantity="fitted order of |ψ_bif(n) − ψ*|", target=2.0, within=0.2, quick=dict(ns=(8, 16, 32)),
+       full_only=True)
+def twisted_column_twist_order(ctx, ns):
+    table = ctx.convergence(dg.limits.convergence(lambda n: abs(critical_twist(n) - zajac_twist()), list(ns)),
+                            "twisted_column_twist_order", title="twisted column: |ψ_bif − ψ*| against n")
+    return float(table.fitted_order)
+
+
+@check("Zajac 1962; Thm 3.13, Def 3.7", "negative control: the clamped column's critical twist is not Greenhill's "
+       "pinned–pinned M L = 2π", quantity="|ψ_bif/2π − 1|", at_least=0.3, quick=dict(n=8), full=dict(n=32))
+def twisted_column_not_pinned(ctx, n):
+    return abs(critical_twist(n) / (2.0 * np.pi) - 1.0)
