@@ -43,7 +43,7 @@ from jaxtyping import Array, Float
 import ddgjax as dg
 from ddgjax import intrinsic
 from ddgjax._checks import check_positive
-from ddgjax.errors import ConvergenceError, DDGError, DegenerateFaceError, InvalidInputError, NonFiniteError
+from ddgjax.errors import ConvergenceError, DDGError, DegenerateFaceError, InvalidInputError, NonFiniteError, ShapeError
 from ddgjax.laplace import (
     check_nondegenerate,
     checked_triangle_mesh,
@@ -57,7 +57,8 @@ from .dirichlet import dirichlet_solve
 
 __all__ = ["METHODS", "between_circles", "cap_volume", "cone_volume", "enclosed_volume", "face_area", "face_volume",
            "harmonic_iteration", "interior_residual", "minimal_surface", "minimal_surface_delaunay",
-           "pinkall_polthier_step", "simplicial", "surface_between_circles", "with_volume"]
+           "pinkall_polthier_step", "simplicial", "surface_between_circles", "with_volume", "with_volumes",
+           "chamber_volumes"]
 
 METHODS = ("auto", "cotan", "newton", "delaunay")
 LOOSE_TOL = 1e-4  # the "auto" method's switch from Fig 6.5 to Newton, relative to the boundary's size
@@ -504,3 +505,66 @@ def with_volume(V, F, volume, boundary=None) -> dg.Problem:
                       constraints=dg.concat(volume=dg.local_sum(cone_volume, F, data=share)),
                       params={"volume": float(volume)}, fixed=np.repeat(fixed[:, None], 3, axis=1),
                       name=f"area with volume {float(volume):.6g} (nv={len(V)}, nf={len(F)})")
+
+
+def chamber_volumes(P: Float[Array, "3 3"], share, params) -> Float[Array, "c"]:
+    """The density of the named constraint `"volumes"` of `with_volumes`: one face's share of
+    vol_c − volumes_c for every chamber c, `share["sign"][c]` det(P)/6 (`face_volume`) minus
+    the face's `share["weight"]` (1/nf) of the prescribed volumes."""
+    return share["sign"] * face_volume(P) - share["weight"] * params["volumes"]
+
+
+def with_volumes(V, F, chambers, volumes) -> dg.Problem:
+    """Foams of a few chambers (a double bubble): the area A = Σ_F A(F) of a closed triangle
+    complex (V, F), whose edges may lie in three faces (where films meet), with the volume of
+    each chamber prescribed, the named constraint
+
+        "volumes":  vol_c − volumes_c = 0,   vol_c = (1/6) Σ_F chambers[F, c] det(v0, v1, v2),
+
+    `chambers` (nf, c) the faces' incidence with the chambers: ±1 where the normal (v1 − v0) ×
+    (v2 − v0) points out of / into chamber c, 0 where the face does not bound it (a shared wall
+    bounds two chambers with opposite signs).  Each chamber's faces must close up (the
+    divergence theorem then makes vol_c the volume it encloses, independent of the origin).
+
+    Critical points: ∇A = Σ_c p_c ∇vol_c with the multipliers p = `multipliers["volumes"]`, the
+    chambers' pressures over the outside: on a film bounding chamber c alone its mean curvature
+    is 2H = p_c, on a wall between chambers c and d it is p_c − p_d (Laplace–Young, as
+    `with_volume`), and where three films meet, the vertex gradient of the area balances at
+    120° (Plateau's laws; Taylor 1976).  The standard double bubble of two equal chambers of
+    volume 9πr³/8 (`ddgjax.mesh.builtin.double_bubble`) has caps of radius r (p = 2/r) and a flat
+    wall, area 27πr²/4, and is the least-area enclosure of two equal volumes (Hutchings, Morgan,
+    Ritoré & Ros 2002).
+
+    **Arguments:** `V` (nv, 3); `F` (nf, 3); `chambers` (nf, c) of −1, 0, 1 with every chamber
+    enclosing a positive volume at the start; `volumes` (c,) finite and positive
+    (`params={"volumes": volumes}`).
+
+    **Raises:** the mesh errors of `simplicial` (without the manifold check: films meet along
+    edges); `ShapeError` (`chambers` not (nf, c), `volumes` not (c,)); `InvalidInputError`
+    (entries of `chambers` other than −1, 0, 1, a chamber with no face or enclosing a
+    non-positive volume at the start — reverse its faces' signs —, `volumes` not finite and
+    positive, naming the chamber).
+    """
+    V, F = checked_triangle_mesh(V, F)
+    check_nondegenerate(V, F)
+    C = np.asarray(chambers, dtype=np.float64)
+    target = np.asarray(volumes, dtype=np.float64)
+    if C.ndim != 2 or C.shape[0] != len(F):
+        raise ShapeError(f"with_volumes: chambers must be (nf, c) = ({len(F)}, c), got shape {C.shape}")
+    if target.shape != (C.shape[1],):
+        raise ShapeError(f"with_volumes: volumes must be ({C.shape[1]},), one per chamber, got shape {target.shape}")
+    if not np.all(np.isin(C, (-1.0, 0.0, 1.0))):
+        f, c = np.argwhere(~np.isin(C, (-1.0, 0.0, 1.0)))[0]
+        raise InvalidInputError(f"with_volumes: chambers[{f}, {c}] = {C[f, c]!r}; the entries are -1, 0 or 1")
+    start = (C * (np.linalg.det(V[F]) / 6.0)[:, None]).sum(axis=0)
+    for c in range(C.shape[1]):
+        if not (np.isfinite(target[c]) and target[c] > 0):
+            raise InvalidInputError(f"with_volumes: volumes[{c}] = {target[c]!r}; a chamber's volume is finite and positive")
+        if not np.any(C[:, c]) or start[c] <= 0:
+            raise InvalidInputError(
+                f"with_volumes: chamber {c} encloses the volume {start[c]:.6g} <= 0 at the start: its faces do not "
+                "bound it with outward normals (reverse the signs of chambers[:, c])")
+    share = {"sign": C, "weight": np.full(len(F), 1.0 / len(F))}
+    return dg.Problem(dg.local_sum(face_area, F), V,
+                      constraints=dg.concat(volumes=dg.local_sum(chamber_volumes, F, data=share)),
+                      params={"volumes": target}, name=f"area with {C.shape[1]} chamber volumes (nv={len(V)}, nf={len(F)})")

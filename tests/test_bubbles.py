@@ -156,3 +156,50 @@ def test_bad_meshes_name_the_element():
         area.with_volume(Vb, Fb, 1.0, boundary=loose)
     with pytest.raises(InvalidInputError, match="boundary vertex 999"):
         area.with_volume(Vb, Fb, 1.0, boundary=[999])
+
+
+def test_double_bubble_mesh_samples_the_standard_double_bubble():
+    """`mesh.double_bubble`: vertices on the caps' spheres (radius 1, centres ∓½ e1) and on the
+    wall's plane; junction edges in three faces; the chambers' volumes → 9π/8 (the polyhedron
+    is inscribed, so below it)."""
+    V, F, C = dg.mesh.double_bubble(24, 6, 4)
+    volumes = (C * (np.linalg.det(V[F]) / 6.0)[:, None]).sum(axis=0)
+    assert np.all(volumes < 9 * np.pi / 8) and np.all(volumes > 0.95 * 9 * np.pi / 8) and volumes[0] == volumes[1]
+    cap_a = np.unique(F[C[:, 1] == 0])
+    np.testing.assert_allclose(np.linalg.norm(V[cap_a] - [-0.5, 0, 0], axis=1), 1.0, atol=1e-15)
+    wall = np.unique(F[(C[:, 0] == 1) & (C[:, 1] == -1)])
+    assert np.all(V[wall, 0] == 0.0)
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    _, count = np.unique(edges, axis=0, return_counts=True)
+    assert set(count.tolist()) == {2, 3} and np.sum(count == 3) == 24
+
+
+def test_unequal_double_bubble_meets_its_volumes_with_the_smaller_chamber_at_higher_pressure():
+    V, F, C = dg.mesh.double_bubble(12, 3, 2)
+    target = 9 * np.pi / 8 * np.array([1.2, 0.8])
+    sol = solve(area.with_volumes(V, F, C, target))
+    X = np.asarray(sol.x)
+    np.testing.assert_allclose((C * (np.linalg.det(X[F]) / 6.0)[:, None]).sum(axis=0), target, rtol=1e-12)
+    p = np.asarray(sol.multipliers["volumes"])
+    assert bool(sol.converged) and p[1] > p[0] > 0
+
+
+def test_with_volumes_bad_input():
+    V, F, C = dg.mesh.double_bubble(12, 3, 2)
+    v = [1.0, 1.0]
+    with pytest.raises(dg.errors.ShapeError, match="chambers"):
+        area.with_volumes(V, F, C[:-1], v)
+    with pytest.raises(dg.errors.ShapeError, match="volumes"):
+        area.with_volumes(V, F, C, [1.0])
+    bad = C.copy()
+    bad[5, 1] = 2.0
+    with pytest.raises(InvalidInputError, match=r"chambers\[5, 1\]"):
+        area.with_volumes(V, F, bad, v)
+    with pytest.raises(InvalidInputError, match=r"volumes\[1\]"):
+        area.with_volumes(V, F, C, [1.0, -1.0])
+    with pytest.raises(InvalidInputError, match="chamber 0 encloses"):
+        area.with_volumes(V, F, -C, v)
+    W = V.copy()
+    W[3, 2] = np.nan
+    with pytest.raises(NonFiniteError, match="vertex 3"):
+        area.with_volumes(W, F, C, v)

@@ -15,7 +15,7 @@ FAST = ["custom_energy", "gauss_bonnet", "heisenberg_chain", "elastica_family", 
 # (their physics is checked by `ddgjax verify`, ext_bubbles), the catenoid fold's continuation ~10 s
 # (ext_continuation), the Willmore energies ~7 s and the Clifford torus ~60 s, the red blood cell ~30 s (ext_willmore): run with
 # `make test-all`
-SLOW = ["twisted_rod", "soap_bubble", "catenoid_fold", "willmore_sphere", "clifford_torus", "red_blood_cell"]
+SLOW = ["twisted_rod", "soap_bubble", "double_bubble", "catenoid_fold", "willmore_sphere", "clifford_torus", "red_blood_cell"]
 
 
 def load(name: str):
@@ -49,6 +49,7 @@ SHOWN = {
     "twisted_rod.png": [("3d", 3, [])],
     "soap_bubble.png": [("3d", 0, ["Poly3DCollection"]), BAR],
     "liquid_bridges.png": [("rectilinear", 2, [])],
+    "double_bubble.png": [("3d", 0, ["Poly3DCollection"]), BAR],
     # area and neck radius against H: smooth catenoids, index 0, index 1, the fold, the smooth fold
     "catenoid_fold.png": [("rectilinear", 5, [])] * 2,
     "willmore_sphere.png": [("3d", 0, ["Poly3DCollection"]), BAR],

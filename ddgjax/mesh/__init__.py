@@ -10,7 +10,8 @@ a gluing word ("abAB") or `Halfedges`.  Surfaces may be non-orientable and have 
   `is_strongly_regular`
 - gluing: `from_word`, `connected_sum`, `normal_form`
 - builtin: `saddle_grid`, `tetrahedron`, `cube`, `octahedron`, `icosahedron`, `icosphere`, `torus`,
-  `projective_plane`, `klein_bottle`, `double_torus`, `disk`, `annulus`, `mobius_strip`
+  `projective_plane`, `klein_bottle`, `double_torus`, `disk`, `annulus`, `mobius_strip`,
+  `double_bubble` (with its chambers)
 - curvature: `corner_angles`, `angle_defect`, `vertex_kind`, `surface_area`, `dihedral_angles`,
   `edge_mean_curvature`, `total_mean_curvature`, `steiner_area`
 - lengths (geometry from edge lengths alone): `edge_lengths`, `triangle_area`,
@@ -32,6 +33,9 @@ from .builtin import (
 )
 from .builtin import (
     disk as disk,
+)
+from .builtin import (
+    double_bubble as double_bubble,
 )
 from .builtin import (
     double_torus as double_torus,

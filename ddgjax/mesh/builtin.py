@@ -35,6 +35,7 @@ __all__ = [
     "cylinder",
     "stretched_sphere",
     "tall_dome",
+    "double_bubble",
 ]
 
 
@@ -292,3 +293,63 @@ def tall_dome(seed: int = 0, n_inner: int = 150, m: int = 32, stretch: float = 5
     F[clockwise] = F[clockwise][:, [0, 2, 1]]
     rho2, phi = np.sum(P**2, axis=1), np.arctan2(P[:, 1], P[:, 0])
     return np.column_stack([P, height * (1 - rho2) + wave * rho2 * np.cos(2 * phi)]), F, np.arange(m)
+
+
+def _ring_band(inner: np.ndarray, outer: np.ndarray) -> np.ndarray:
+    """The triangles of the band between two rings of m vertex indices (inner → outer)."""
+    i = np.arange(inner.size)
+    j = np.roll(i, -1)
+    return np.concatenate([np.stack([inner[i], outer[i], outer[j]], 1), np.stack([inner[i], outer[j], inner[j]], 1)])
+
+
+def _capped_rings(centre: int, rings: list) -> np.ndarray:
+    """A fan around `centre` to the first ring, then the bands between consecutive rings."""
+    first = rings[0]
+    fan = np.stack([np.full(first.size, centre), first, np.roll(first, -1)], 1)
+    return np.concatenate([fan] + [_ring_band(a, b) for a, b in zip(rings[:-1], rings[1:])])
+
+
+def double_bubble(m: int = 24, k: int = 6, k_wall: int = 4, radius: float = 1.0):
+    """The standard double bubble of two equal chambers, sampled: `(V, F, chambers)`.
+
+    Two spheres of radius r = `radius` with centres (∓r/2, 0, 0), each without the cap beyond
+    the plane x = 0, and the flat disk of radius (√3/2) r in that plane (the wall): three sheets
+    meeting at 120° along the junction circle (Plateau's laws), each chamber of volume 9πr³/8.
+    Each cap is a pole, k − 1 rings at polar angles 120° j/k about its centre and the junction
+    ring; the wall a centre and k_wall − 1 rings; every ring has m vertices.  The edges on the
+    junction lie in three faces: the mesh is not a manifold there.
+
+    `chambers` (nf, 2): +1 where the face's normal (v1 − v0) × (v2 − v0) points out of chamber
+    c, −1 where into it, 0 where the face does not bound it (the caps' normals point outwards,
+    the wall's along +x: out of chamber 0, into chamber 1), so that the volume of chamber c is
+    Σ_f chambers[f, c] det(V[F[f]])/6 (`energies.area.with_volumes`).
+    """
+    _check_grid(m=(m, 3), k=(k, 2), k_wall=(k_wall, 1))
+    theta = 2 * np.pi * np.arange(m) / m
+    circle = np.stack([np.zeros(m), np.cos(theta), np.sin(theta)], 1)
+    points, count = [], [0]
+
+    def add(P):
+        points.append(np.atleast_2d(P))
+        count[0] += len(points[-1])
+        return np.arange(count[0] - len(points[-1]), count[0])
+
+    junction = add(np.sqrt(3.0) / 2.0 * radius * circle)
+    faces, chambers = [], []
+    for side, chamber in ((-1.0, (1, 0)), (1.0, (0, 1))):
+        centre = np.array([side * radius / 2.0, 0.0, 0.0])
+        pole = add(centre + [side * radius, 0.0, 0.0])[0]
+        rings = []
+        for j in range(1, k):
+            phi = (2.0 * np.pi / 3.0) * j / k
+            rings.append(add(centre + radius * (np.cos(phi) * np.array([side, 0.0, 0.0]) + np.sin(phi) * circle)))
+        cap = _capped_rings(pole, rings + [junction])
+        faces.append(cap[:, ::-1] if side < 0 else cap)  # normals away from the centre
+        chambers.append(np.tile(chamber, (len(cap), 1)))
+    centre = add(np.zeros(3))[0]
+    rings = [add(np.sqrt(3.0) / 2.0 * radius * j / k_wall * circle) for j in range(1, k_wall)]
+    wall = _capped_rings(centre, rings + [junction])  # normals along +x
+    faces.append(wall)
+    chambers.append(np.tile((1, -1), (len(wall), 1)))
+    V, F = _mesh(np.concatenate(points), np.concatenate(faces))
+    return V, F, np.concatenate(chambers).astype(np.float64)

@@ -8,6 +8,12 @@ checks solve bubbles (a perturbed icosphere with the volume 4π/3 of the unit sp
 liquid bridges (the film between two coaxial unit circles at z = ±H: with the cylinder's volume
 p → 1; with more volume it bulges into a Delaunay surface of revolution whose pressure comes
 from the smooth profile by shooting, `liquid_bridge_pressure`).
+
+Double bubbles (`energies.area.with_volumes`, several chambers; the films meet three at an edge):
+from the sampled standard double bubble of two equal chambers (`ddgjax.mesh.builtin.double_bubble`,
+caps of radius r = 1, flat wall), the solved pressures converge to Laplace–Young's 2/r; with
+unequal volumes the caps and the wall become spheres of radii r_A, r_B, r_W (fitted) with
+1/r_W = 1/r_B − 1/r_A, the standard double bubble of Hutchings, Morgan, Ritoré & Ros (2002).
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ from scipy.optimize import brentq, fsolve
 import ddgjax as dg
 from ddgjax.verify import check
 from energies import area
+from solvers import solve
 
 SPHERE_VOLUME = 4.0 * np.pi / 3.0  # the unit ball: p = 2/r = 2
 BRIDGE_H = 0.5  # the bridges span the unit circles at z = ±H
@@ -163,3 +170,101 @@ def bulging_bridge_order(ctx, ns):
        quantity="|p·1 − 2| for the volume 8 · 4π/3 (level 1)", at_least=0.5, quick=dict(level=1))
 def wrong_volume_misses_unit_pressure(ctx, level):
     return abs(bubble(level, 8.0 * SPHERE_VOLUME)["pressure"] - 2.0)
+
+
+# --- double bubbles: two chambers, three films along a junction -----------------------------------
+
+DOUBLE_VOLUME = 9.0 * np.pi / 8.0  # each chamber of the standard double bubble with caps of radius 1
+UNEQUAL = (1.2, 0.8)  # the unequal chambers, in units of DOUBLE_VOLUME
+
+
+@lru_cache(maxsize=None)
+def double_bubble_solution(m: int, shares: tuple = (1.0, 1.0)):
+    """`(solution, F, chambers)`: `area.with_volumes` on `double_bubble(m, m // 4, round(m / 6))`
+    with the volumes `shares` × 9π/8, solved from the equal-volume standard double bubble."""
+    V, F, C = dg.mesh.builtin.double_bubble(m, m // 4, max(2, round(m / 6)))
+    return solve(area.with_volumes(V, F, C, DOUBLE_VOLUME * np.asarray(shares))), F, C
+
+
+def sphere_radius(P: np.ndarray) -> float:
+    """The radius of the least-squares sphere through the points P (algebraic fit:
+    |x|² = 2c·x + r² − |c|², linear in (c, r² − |c|²))."""
+    A = np.column_stack([2.0 * P, np.ones(len(P))])
+    coef = np.linalg.lstsq(A, (P**2).sum(axis=1), rcond=None)[0]
+    return float(np.sqrt(coef[3] + coef[:3] @ coef[:3]))
+
+
+def sheet_radii(m: int) -> tuple[float, float, float]:
+    """`(r_A, r_B, r_W)`: the fitted radii of the two caps and the wall of the unequal double bubble."""
+    sol, F, C = double_bubble_solution(m, UNEQUAL)
+    X = np.asarray(sol.x)
+    sheets = (C[:, 1] == 0, C[:, 0] == 0, (C[:, 0] != 0) & (C[:, 1] != 0))
+    return tuple(sphere_radius(X[np.unique(F[mask])]) for mask in sheets)
+
+
+def pressure_error(m: int) -> float:
+    """max_c |p_c r/2 − 1| of the equal double bubble (r = 1)."""
+    sol = double_bubble_solution(m)[0]
+    return float(np.max(np.abs(np.asarray(sol.multipliers["volumes"]) / 2.0 - 1.0)))
+
+
+@check("Laplace–Young; Plateau", "a double bubble of two equal chambers of volume 9π/8 (started from the sampled "
+       "standard double bubble): both pressures converge to that of its caps of radius 1, p = 2/r = 2, at order 2",
+       quantity="fitted order of max_c |p_c/2 − 1|", target=2.0, within=0.2, quick=dict(ns=(12, 16, 24)),
+       full=dict(ns=(12, 16, 24, 48)))
+def double_bubble_pressure_order(ctx, ns):
+    table = ctx.convergence(dg.limits.convergence(pressure_error, list(ns)), "double_bubble_pressure_order",
+                            title="double bubble: max |p/2 − 1| against the ring size m")
+    return float(table.fitted_order)
+
+
+@check("Laplace–Young; Euler's homogeneous function theorem", "at a critical double bubble 2A = 3 Σ_c p_c vol_c "
+       "(the area is homogeneous of degree 2 and the volumes of degree 3 in the positions, so scaling is a direction "
+       "of the KKT system), to the KKT tolerance, and every solve converged",
+       quantity="max over m and both volume pairs of |2A − 3 Σ p_c vol_c| / A", at_most=1e-9,
+       quick=dict(ns=(12, 16, 24)), full=dict(ns=(12, 16, 24, 48)))
+def double_bubble_scaling_identity(ctx, ns):
+    worst = 0.0
+    for m in ns:
+        for shares in ((1.0, 1.0), UNEQUAL):
+            sol = double_bubble_solution(m, shares)[0]
+            if not bool(sol.converged):
+                return float("inf")
+            A, p = float(sol.energy), np.asarray(sol.multipliers["volumes"])
+            worst = max(worst, abs(2.0 * A - 3.0 * float(p @ (DOUBLE_VOLUME * np.asarray(shares)))) / A)
+    return worst
+
+
+@check("Hutchings, Morgan, Ritoré & Ros 2002", "the double bubble of chambers 1.2 and 0.8 × 9π/8 is the standard one: "
+       "its caps and its wall approach spheres (fitted radii r_A, r_B, r_W) with 1/r_W = 1/r_B − 1/r_A",
+       quantity="fitted order of |1/r_W − 1/r_B + 1/r_A| (≈ 2.4 measured, pre-asymptotic)", at_least=1.5,
+       quick=dict(ns=(12, 16, 24)), full=dict(ns=(12, 16, 24, 32)))
+def double_bubble_standard_radii(ctx, ns):
+    def defect(m):
+        r_a, r_b, r_w = sheet_radii(m)
+        return abs(1.0 / r_w - 1.0 / r_b + 1.0 / r_a)
+
+    table = ctx.convergence(dg.limits.convergence(defect, list(ns)), "double_bubble_standard_radii",
+                            title="unequal double bubble: |1/r_W − 1/r_B + 1/r_A| against m")
+    return float(table.fitted_order)
+
+
+@check("Laplace–Young", "the unequal double bubble's pressures converge to its caps' 2/r_A and 2/r_B (fitted radii) "
+       "at order 2", quantity="fitted order of max(|p_A r_A/2 − 1|, |p_B r_B/2 − 1|)", target=2.0, within=0.2,
+       quick=dict(ns=(12, 16, 24)), full=dict(ns=(12, 16, 24, 32)))
+def double_bubble_unequal_pressures(ctx, ns):
+    def error(m):
+        r_a, r_b, _ = sheet_radii(m)
+        p = np.asarray(double_bubble_solution(m, UNEQUAL)[0].multipliers["volumes"])
+        return max(abs(p[0] * r_a / 2.0 - 1.0), abs(p[1] * r_b / 2.0 - 1.0))
+
+    table = ctx.convergence(dg.limits.convergence(error, list(ns)), "double_bubble_unequal_pressures",
+                            title="unequal double bubble: |p r/2 − 1| against m")
+    return float(table.fitted_order)
+
+
+@check("Laplace–Young", "negative control: the equal double bubble's pressure is not that of one sphere holding both "
+       "chambers (radius (27/16)^(1/3))", quantity="|p/p_sphere − 1|", at_least=0.1, quick=dict(m=24), full=dict(m=48))
+def double_bubble_not_one_sphere(ctx, m):
+    p = float(double_bubble_solution(m)[0].multipliers["volumes"][0])
+    return abs(p / (2.0 / (3.0 * 2.0 * DOUBLE_VOLUME / (4.0 * np.pi)) ** (1.0 / 3.0)) - 1.0)
