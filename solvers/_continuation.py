@@ -387,7 +387,8 @@ def continuation(
     steps along the branch until it reaches p1 (the last point then lies at p = p1 exactly), turns
     back past p0 (the last point at p0: e.g. the other branch of a fold), `max_points` are taken,
     or the step length falls below `ds_min`.  Folds (`dp/ds = 0`) are refined; the Morse index
-    (`solvers.stability`) is evaluated at every point.
+    (`solvers.stability`) is evaluated at every point, and a change of it that no fold explains
+    is a bifurcation, refined to the zero of the crossing eigenvalue (`Branch.bifurcations`).
 
     **Arguments:**
     - `problem_of(p) -> Problem`: one declaration (the same energy and constraints functions,
@@ -402,7 +403,7 @@ def continuation(
       every point (as in `solve`); `max_corrector`: Newton steps per corrector.
     - `index`: compute the Morse index at each point (`solvers.stability`: by the inertia of the
       sparse KKT matrix for problems declared local, else dense eigenvalues, N ≲ 2,000);
-      `refine_folds`: refine the folds (else report the nearer point).
+      `refine_folds`: refine the folds and bifurcations (else report the nearer point).
 
     **Returns:** a `Branch`.
 
