@@ -5,7 +5,8 @@ constraints' tangent space, the zero modes of Euclidean motions removed.  A crit
 strict local minimum iff it is positive definite; the number of negative eigenvalues is the
 Morse index.  Objects: the two catenoids between the unit circles at z = ±½ (Sec 6.4; the one
 with the larger neck is stable, the other has index 1) and the closed elastica (the regular
-polygon, a minimum; Euler's figure-eight, a saddle, Remark 3.7).
+polygon, a minimum; Euler's figure-eight, a saddle, Remark 3.7), and soap bubbles (a single
+bubble and the standard double bubble: minima, index 0, with the six Euclidean zero modes).
 """
 
 from __future__ import annotations
@@ -103,3 +104,33 @@ def figure_eight_index(ctx, n):
     problem, sol, _ = figure_eight(n)
     result = stability(problem, sol, k=3)
     return float(result.index) if result.zero_modes == 3 else -1.0
+
+
+@functools.cache
+def bubble(level: int):
+    """`(problem, solution)`: the soap bubble of volume 4π/3 from the perturbed icosphere
+    (`ext_bubbles.sphere_start`), solved."""
+    from .ext_bubbles import SPHERE_VOLUME, sphere_start
+
+    V, F = sphere_start(level)
+    problem = area.with_volume(V, F, SPHERE_VOLUME)
+    return problem, solve(problem)
+
+
+@check("Sec 3.1; Laplace–Young", "the soap bubble (volume 4π/3, a perturbed icosphere solved) is a stable critical "
+       "point: Morse index 0, with exactly six zero modes removed (the three translations and three rotations, "
+       "which keep area and volume)", quantity="index + |zero modes − 6|", at_most=0.0, quick=dict(level=1),
+       full=dict(level=2))
+def bubble_is_stable(ctx, level):
+    result = stability(*bubble(level), k=2)
+    return float(result.index + abs(result.zero_modes - 6))
+
+
+@check("Sec 3.1; Hutchings, Morgan, Ritoré & Ros 2002", "the standard double bubble of two equal chambers is a "
+       "stable critical point of the area at fixed chamber volumes: Morse index 0, six zero modes (Euclidean motions)",
+       quantity="index + |zero modes − 6|", at_most=0.0, quick=dict(m=12), full=dict(m=24))
+def double_bubble_is_stable(ctx, m):
+    V, F, C = dg.mesh.double_bubble(m, m // 4, max(2, round(m / 6)))
+    problem = area.with_volumes(V, F, C, [9.0 * np.pi / 8.0] * 2)
+    result = stability(problem, solve(problem), k=2)
+    return float(result.index + abs(result.zero_modes - 6))
