@@ -409,8 +409,10 @@ def loaded(n: int, *, load: float = 0.0, length: float = 1.0, direction=(1.0, 0.
         raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
     length = checked_length(length)
     d = unit_vector(direction, "direction")
-    if is_concrete(load) and not np.all(np.isfinite(np.asarray(load, dtype=float))):
-        raise InvalidInputError(f"load must be finite, got {load!r}")
+    load = jnp.asarray(load, dtype=float)
+    checked_shape(load, (), "load")
+    if is_concrete(load) and not np.isfinite(float(load)):
+        raise InvalidInputError(f"load must be finite, got {float(load)!r}")
     e1 = _perpendicular(d, jnp)
     across = jnp.stack([e1, jnp.cross(d, e1)])
     T0 = starting_array(x0, lambda: jnp.tile(d, (n, 1)), (n, 3))
@@ -420,7 +422,7 @@ def loaded(n: int, *, load: float = 0.0, length: float = 1.0, direction=(1.0, 0.
         unit=dg.local_map(_unit, free_edges[:, None]),
         lateral=dg.local_sum(_lateral, np.arange(n)[:, None]),
     )
-    params = {"h": length / n, "load": jnp.asarray(load, dtype=float), "t_start": d, "t_end": d, "across": across}
+    params = {"h": length / n, "load": load, "t_start": d, "t_end": d, "across": across}
     return dg.Problem(energy, T0, constraints=constraints, params=params, fixed=fixed,
                       name=f"Euler's column (n={n}, clamp={clamp})")
 

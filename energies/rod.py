@@ -290,19 +290,22 @@ def loaded(n: int, *, alpha: float, twist: float = 0.0, load: float = 0.0, lengt
     Constraints `{"lateral": (2,), "unit": (m,)}`; params as `clamped` (without the chord) and
     `"load"`.  **Raises:** as `clamped`, and `InvalidInputError` for a non-finite twist or load.
     """
+    twist, load = jnp.asarray(twist, dtype=float), jnp.asarray(load, dtype=float)
     for value, name in ((twist, "twist"), (load, "load")):
-        if is_concrete(value) and not np.all(np.isfinite(np.asarray(value, dtype=float))):
-            raise InvalidInputError(f"{name} must be finite, got {value!r}")
+        checked_shape(value, (), name)
+        if is_concrete(value) and not np.isfinite(float(value)):
+            raise InvalidInputError(f"{name} must be finite, got {float(value)!r}")
+    n = checked_count(n, 3, "n, the number of edges of a twisted column,")
     q0, q1 = twisted_frame(0.0), twisted_frame(twist)
-    s = (np.arange(n) + 0.5) / max(int(n), 1) if clamp == "vertex" else np.linspace(0.0, 1.0, max(int(n), 1))
-    column = jnp.stack([twisted_frame(twist * t) for t in s]) if isinstance(n, (int, np.integer)) and n >= 3 else None
+    s = (np.arange(n) + 0.5) / n if clamp == "vertex" else np.linspace(0.0, 1.0, n)
+    column = jnp.stack([twisted_frame(twist * t) for t in s])
     base = clamped(n, alpha=alpha, length=length, chord=(0.5 * length, 0.0, 0.0), frame_start=q0, frame_end=q1,
                    clamp=clamp, x0=column if x0 is None else x0)
     edges = np.arange(n)
     energy = base.energy + dg.local_sum(_load_potential, edges[:, None])
     free_edges = edges[1:-1] if clamp == "edge" else edges
     constraints = dg.concat(unit=dg.local_map(_unit, free_edges[:, None]), lateral=dg.local_sum(_lateral, edges[:, None]))
-    params = {k: v for k, v in base.params.items() if k != "chord"} | {"load": jnp.asarray(load, dtype=float)}
+    params = {k: v for k, v in base.params.items() if k != "chord"} | {"load": load}
     return dg.Problem(energy, base.x0, constraints=constraints, params=params, fixed=base.fixed,
                       name=f"twisted column (n={n}, clamp={clamp})")
 

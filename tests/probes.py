@@ -563,6 +563,30 @@ def catalogue_probes() -> list[Probe]:
     Vn[3, 0] = np.nan
     probes.append(Probe("catalogue:willmore.conformal:vertex 3 nan", _bind(willmore.conformal, Vn, Fc), names=VERTEX))
     probes.append(Probe("catalogue:willmore.helfrich:open mesh", _bind(willmore.helfrich, V, F), expect="finite_or_raises"))
+    for value, why in ((np.nan, "nan"), (np.inf, "inf")):
+        probes.append(Probe(f"catalogue:elastica.loaded:load {why}", _bind(elastica.loaded, 8, load=value), names=(r"load",)))
+        probes.append(Probe(f"catalogue:rod.loaded:twist {why}", _bind(rod.loaded, 8, alpha=1.0, twist=value), names=(r"twist",)))
+        probes.append(Probe(f"catalogue:rod.loaded:load {why}", _bind(rod.loaded, 8, alpha=1.0, load=value), names=(r"load",)))
+    probes.append(Probe("catalogue:elastica.loaded:load shape (2,)", _bind(elastica.loaded, 8, load=[1.0, 2.0]), names=(r"load",)))
+    probes.append(Probe("catalogue:rod.loaded:twist shape (2,)", _bind(rod.loaded, 8, alpha=1.0, twist=[1.0, 2.0]),
+                        names=(r"twist",)))
+    for n in (0, 2, 2.5, np.nan):
+        probes.append(Probe(f"catalogue:elastica.loaded:n = {n!r}", _bind(elastica.loaded, n), names=(r"\bn\b",)))
+        probes.append(Probe(f"catalogue:rod.loaded:n = {n!r}", _bind(rod.loaded, n, alpha=1.0), names=(r"\bn\b",)))
+    for d, why in (((0, 0, 0), "zero"), ((np.nan, 1, 0), "nan"), ((1, 0), "shape (2,)")):
+        probes.append(Probe(f"catalogue:elastica.loaded:direction {why}", _bind(elastica.loaded, 8, direction=d),
+                            names=(r"direction",)))
+    Vb, Fb, Cb = __import__("ddgjax").mesh.double_bubble(12, 3, 2)
+    for vols, why, names in (([1.0, np.nan], "volume nan", (r"volumes\[1\]",)), ([1.0, -1.0], "volume negative", (r"volumes\[1\]",)),
+                             ([1.0], "one volume for two chambers", (r"volumes",))):
+        probes.append(Probe(f"catalogue:area.with_volumes:{why}", _bind(area.with_volumes, Vb, Fb, Cb, vols), names=names))
+    probes.append(Probe("catalogue:area.with_volumes:chambers reversed", _bind(area.with_volumes, Vb, Fb, -Cb, [1.0, 1.0]),
+                        names=(r"chamber 0",)))
+    probes.append(Probe("catalogue:area.with_volumes:chambers shape", _bind(area.with_volumes, Vb, Fb, Cb[:-1], [1.0, 1.0]),
+                        names=(r"chambers",)))
+    Vbn = Vb.copy()
+    Vbn[3, 1] = np.nan
+    probes.append(Probe("catalogue:area.with_volumes:vertex 3 nan", _bind(area.with_volumes, Vbn, Fb, Cb, [1.0, 1.0]), names=VERTEX))
     return probes
 
 
