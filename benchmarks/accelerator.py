@@ -48,6 +48,7 @@ import ddgjax as dg  # noqa: F401,E402  (float64)
 from ddgjax.laplace import cotan_laplacian  # noqa: E402
 from ddgjax.mesh import saddle_grid  # noqa: E402
 from energies import dirichlet  # noqa: E402
+from multigrid import measure  # noqa: E402
 from scale import area_problem  # noqa: E402
 from solvers import Krylov, SparseDirect, solve  # noqa: E402
 
@@ -69,22 +70,6 @@ def dirichlet_problem(k: int):
     V, F, b = saddle_grid(k)
     V = np.column_stack([V[:, 0], V[:, 1], np.zeros(len(V))])
     return dirichlet.cotan(V, F, b, np.exp(V[b, 0]) * np.sin(V[b, 1])), (V, F, b)
-
-
-def timed_solves(problem, linear_solver, tol: float, repeats: int):
-    t0 = time.perf_counter()
-    sol = solve(problem, linear_solver=linear_solver, tol=tol, throw=False)
-    sol.x.block_until_ready()
-    first = time.perf_counter() - t0
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        sol = solve(problem, linear_solver=linear_solver, tol=tol, throw=False)
-        sol.x.block_until_ready()
-        times.append(time.perf_counter() - t0)
-    median = statistics.median(times)
-    return sol, {"overhead": first - median, "solve": median, "per_step": median / max(int(sol.steps), 1),
-                 "steps": int(sol.steps), "residual": float(sol.residual), "converged": bool(sol.converged)}
 
 
 def device_qr(mesh, repeats: int):
@@ -112,7 +97,7 @@ def device_qr(mesh, repeats: int):
     residual = float(np.max(np.abs(A @ np.asarray(x) - rhs)) / np.max(np.abs(rhs)))
     f = np.zeros(len(V))
     f[b], f[interior] = f_b, np.asarray(x)
-    return f, {"overhead": first - median, "solve": median, "per_step": median, "steps": 1, "residual": residual,
+    return f, {"compile": first - median, "solve": median, "per_step": median, "steps": 1, "residual": residual,
                "converged": residual < 1e-8}
 
 
@@ -172,7 +157,7 @@ def main():
                 if key == "qr":
                     x, r = device_qr(mesh, repeats)
                 else:
-                    sol, r = timed_solves(problem, make(), tol, repeats)
+                    sol, r = measure(problem, make(), repeats, tol)
                     x = np.asarray(sol.x)
             except Exception as error:  # a back end the device cannot run: reported, the table goes on
                 print(f"| {backend} | {name} | {k * k} | {n} | {label} | failed: {type(error).__name__}: "
@@ -182,7 +167,7 @@ def main():
             diff = "" if x_ref is None else f"{float(np.max(np.abs(x - x_ref))):.1e}"
             x_ref = x if x_ref is None else x_ref
             peak = device_peak_gb()
-            print(f"| {backend} | {name} | {k * k} | {n} | {label} | {r['overhead']:.1f} | {r['per_step']:.4f} | "
+            print(f"| {backend} | {name} | {k * k} | {n} | {label} | {r['compile']:.1f} | {r['per_step']:.4f} | "
                   f"{r['steps']} | {r['residual']:.1e} | {diff} | {'' if peak is None else f'{peak:.2f}'} |", flush=True)
             if args.json:
                 with open(args.json, "a") as out:

@@ -52,8 +52,8 @@ def measure(problem, linear_solver, repeats: int, tol: float):
         sol.x.block_until_ready()
         times.append(time.perf_counter() - t0)
     median = statistics.median(times)
-    return sol, {"compile": first - median, "per_step": median / max(int(sol.steps), 1), "steps": int(sol.steps),
-                 "residual": float(sol.residual)}
+    return sol, {"compile": first - median, "solve": median, "per_step": median / max(int(sol.steps), 1),
+                 "steps": int(sol.steps), "residual": float(sol.residual), "converged": bool(sol.converged)}
 
 
 def minres_iterations(problem, linear_solver, x) -> tuple[int, float]:
