@@ -56,6 +56,7 @@ __all__ = [
     "bending_energy",
     "clamped",
     "clamped_bending",
+    "finite_scalar",
     "closed",
     "loaded",
     "load",
@@ -367,6 +368,16 @@ def clamped_bending(n: int, T0, t_start, t_end, clamp: str):
     return energy, T0, fixed, edges
 
 
+def finite_scalar(value, name: str) -> Float[Array, ""]:
+    """`value` as a float64 scalar; `ShapeError` unless it is one, `InvalidInputError` unless it
+    is finite (when concrete), naming it."""
+    value = jnp.asarray(value, dtype=float)
+    checked_shape(value, (), name)
+    if is_concrete(value) and not np.isfinite(float(value)):
+        raise InvalidInputError(f"{name} must be finite, got {float(value)!r}")
+    return value
+
+
 def _load_potential(T1, p):
     return p["load"] * p["h"] * jnp.dot(T1[0], p["t_start"])
 
@@ -409,10 +420,7 @@ def loaded(n: int, *, load: float = 0.0, length: float = 1.0, direction=(1.0, 0.
         raise InvalidInputError(f"clamp must be 'edge' or 'vertex', got {clamp!r}")
     length = checked_length(length)
     d = unit_vector(direction, "direction")
-    load = jnp.asarray(load, dtype=float)
-    checked_shape(load, (), "load")
-    if is_concrete(load) and not np.isfinite(float(load)):
-        raise InvalidInputError(f"load must be finite, got {float(load)!r}")
+    load = finite_scalar(load, "load")
     e1 = _perpendicular(d, jnp)
     across = jnp.stack([e1, jnp.cross(d, e1)])
     T0 = starting_array(x0, lambda: jnp.tile(d, (n, 1)), (n, 3))

@@ -54,11 +54,12 @@ from jaxtyping import Array, Float
 import ddgjax as dg
 from ddgjax import frames
 from ddgjax import quaternion as qt
-from ddgjax._checks import check_finite, checked_count, checked_shape, is_concrete, when_concrete
+from ddgjax._checks import check_finite, checked_count, checked_shape, when_concrete
 from ddgjax.errors import InvalidInputError
 
 from .elastica import (
-    bending_density, checked_chord, checked_length, clamp_ends, start_data, starting_array, unit_and_chord,
+    bending_density, checked_chord, checked_length, clamp_ends, finite_scalar, start_data, starting_array,
+    unit_and_chord,
 )
 
 __all__ = [
@@ -290,11 +291,7 @@ def loaded(n: int, *, alpha: float, twist: float = 0.0, load: float = 0.0, lengt
     Constraints `{"lateral": (2,), "unit": (m,)}`; params as `clamped` (without the chord) and
     `"load"`.  **Raises:** as `clamped`, and `InvalidInputError` for a non-finite twist or load.
     """
-    twist, load = jnp.asarray(twist, dtype=float), jnp.asarray(load, dtype=float)
-    for value, name in ((twist, "twist"), (load, "load")):
-        checked_shape(value, (), name)
-        if is_concrete(value) and not np.isfinite(float(value)):
-            raise InvalidInputError(f"{name} must be finite, got {float(value)!r}")
+    twist, load = finite_scalar(twist, "twist"), finite_scalar(load, "load")
     n = checked_count(n, 3, "n, the number of edges of a twisted column,")
     q0, q1 = twisted_frame(0.0), twisted_frame(twist)
     s = (np.arange(n) + 0.5) / n if clamp == "vertex" else np.linspace(0.0, 1.0, n)
