@@ -222,16 +222,17 @@ def laplacian_of_corner_weights(F, w, n_vertices: int) -> sp.csr_matrix:
 def laplacian_of_edge_weights(i, j, w, n_vertices: int) -> sp.csr_matrix:
     """The Laplacian (nv, nv) csr with the weight w[e] on the edge (i[e], j[e]),
     (L f)_i = Σ_j ν_ij (f_i − f_j): several edges between two vertices add their weights, loops
-    (i = j) drop out.  Assembled directly (one sort, no cache): for a connectivity used once,
-    such as an intrinsic triangulation after flips."""
+    (i = j) drop out.  Assembled directly in canonical CSR (`ddgjax.csr_assembly`, no cache): for
+    a connectivity used once, such as an intrinsic triangulation after flips."""
+    from .csr_assembly import edge_laplacian_csr
+
     n = n_vertices
     index = np.int32 if n < np.iinfo(np.int32).max else np.int64  # scipy's own index type
-    i, j = i.astype(index), j.astype(index)
-    w = np.where(i != j, w, 0.0)
-    diagonal = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
-    vertices = np.arange(n, dtype=index)
-    rows, cols = np.concatenate([i, j, vertices]), np.concatenate([j, i, vertices])
-    return sp.csr_matrix((np.concatenate([-w, -w, diagonal]), (rows, cols)), shape=(n, n))
+    data, indices, indptr = edge_laplacian_csr(np.asarray(i).astype(index), np.asarray(j).astype(index), w, n)
+    L = sp.csr_matrix((data, indices, indptr), shape=(n, n))
+    L.has_sorted_indices = True
+    L.has_canonical_format = True
+    return L
 
 
 def cotan_laplacian(V, F) -> sp.csr_matrix:

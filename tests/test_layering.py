@@ -38,6 +38,7 @@ LAYER_OF_PREFIX = {
     "ddgjax.mesh": GEOMETRY,
     "ddgjax.intrinsic": GEOMETRY,
     "ddgjax.laplace": GEOMETRY,
+    "ddgjax.csr_assembly": GEOMETRY,
     "ddgjax.smooth": SMOOTH,
     "ddgjax.plot": OUTPUT,
     "ddgjax.verify": APPLICATION,
