@@ -346,6 +346,7 @@ def refined_catenoid():
     return refine(lambda V, F: area.simplicial(V, F), V, F, levels=2, project=onto_circles, tol=1e-10)
 
 
+@pytest.mark.slow  # a convergence study (three levels, about 60 Newton steps); the quick runs have catenoid_neck_order
 def test_refined_catenoid_neck_converges_at_order_two(refined_catenoid):
     """The minimal surface spanned by the unit circles at z = ±1/2, refined from cylinder(4) with
     the boundary vertices projected onto the circles: the neck radius tends to the catenoid's
