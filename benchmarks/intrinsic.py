@@ -43,6 +43,12 @@ flip more than a repeated call).  Of the flip phase, the compiled loop with its 
 takes about 100–130 (ellipsoid) and 70–90 (torus) ns per flip, memory-bound on the ellipsoid
 (65–80 ns per flip on meshes that fit in cache), and the derived cotangents of the result
 (gather, one autodiff kernel on all faces, interleave) about 25–45 ms.
+On 2026-12-04 (a slower 2-core machine, load 1–2), before the Laplacian was assembled row by
+row in CSR (`ddgjax.csr_assembly`) one `--large` run gave igl / ddgjax 2.07 (sphere), 2.61
+(ellipsoid), 1.96 (torus); after it three runs gave 2.88, 2.06, 2.08 (sphere), 2.74, 2.89, 2.78
+(ellipsoid), 2.09, 2.18, 2.04 (torus), flip phase 141–146 and 98–103 ns per flip.  Of the
+torus's 0.61 s: gluing 0.13, lengths and checks 0.08, flips 0.19 plus the derived cotangents of
+the result 0.04, CSR assembly 0.09 (was 0.15 through scipy's COO → CSR).
 "rounds" is the longest cascade of flips (`FlipResult.n_rounds`).  Time grows about linearly;
 meshes whose vertex labels are not spatially coherent are renumbered along a Morton curve first
 (`ddgjax.intrinsic.ordering`), for cache locality.  Results do not depend on the flip order
