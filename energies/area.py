@@ -15,7 +15,10 @@ harmonic for its own cotan Laplacian, L f = 0 at the interior vertices.
 - `method="delaunay"`: Fig 7.23, minimal surfaces in the narrow sense (Def 7.9): the same
   iteration, but each step first makes the triangulation intrinsically Delaunay by edge flips
   and solves with its Laplace–Beltrami operator, keeping the new combinatorics; it stops when the
-  triangulation is Delaunay for the current surface and the residual is below `tol`.  Then S is
+  triangulation is Delaunay for the current surface and the residual is below `tol`.  Run to a
+  loose tolerance, then accelerated by Newton's method on the area of the current triangulation
+  (its fixed points are exactly the critical points of A_T with T Delaunay), with re-flips until
+  the triangulation is Delaunay for Newton's solution (`minimal_surface_delaunay`).  Then S is
   critical for the area (Thm 6.7, Remark 7.10) and, all weights being ≥ 0, every interior vertex
   lies in the convex hull of its neighbours (maximum principle, Prop 6.8).  The surface is
   carried as a gluing (`ddgjax.intrinsic.Triangulation`), so the flipped triangulations may be
@@ -240,13 +243,87 @@ def _report(flip, history, flips, areas, breakdown, tol) -> dict:
 
 
 def minimal_surface_delaunay(V, F, boundary=None, *, tol: float = 1e-10, max_iter: int = 1000,
-                             delaunay_tol: float = intrinsic.delaunay.DELAUNAY_TOL, throw: bool = True):
-    """Minimal surface in the narrow sense by the algorithm of Fig 7.23 (Def 7.9):
-    `harmonic_iteration(..., flip=True)`.  The returned F is the final (Delaunay) triangulation,
+                             delaunay_tol: float = intrinsic.delaunay.DELAUNAY_TOL, throw: bool = True,
+                             newton: bool = True):
+    """Minimal surface in the narrow sense (Def 7.9) by the algorithm of Fig 7.23,
+    `harmonic_iteration(..., flip=True)`, accelerated by Newton's method.
+
+    Fig 7.23 contracts linearly, slowly where the surface moves tangentially (on a non-planar
+    boundary it is still at ~1e-5 after thousands of iterations).  Its fixed points are the
+    surfaces S with a triangulation T that is Delaunay for S and ∇A_T(S) = L_T f = 0 (Thm 6.7,
+    Remark 7.10: L_T is then the Laplace–Beltrami operator).  So with `newton=True` (default)
+    the iteration runs to a loose tolerance (`LOOSE_TOL` of the boundary's size), then Newton's
+    method (`solvers.solve`, a critical point of any index) solves ∇A_T = 0 on the current
+    triangulation T; if T is Delaunay for the solution, it is a fixed point of Fig 7.23 to `tol`;
+    otherwise a few Fig 7.23 steps re-flip T and Newton runs again (at most `NARROW_ROUNDS`
+    times).  `newton=False` is the plain iteration.  `max_iter` bounds the iterations and Newton
+    steps together.
+
+    **Returns:** `(V, F, info)` as `harmonic_iteration`; F is the final (Delaunay) triangulation,
     possibly with other combinatorics than the input (a face may repeat a vertex if the surface
-    degenerates)."""
-    return harmonic_iteration(V, F, boundary, flip=True, tol=tol, max_iter=max_iter,
-                              delaunay_tol=delaunay_tol, throw=throw)
+    degenerates); info also `newton_iterations` (0 without Newton).
+    """
+    if newton:
+        V1, F1, info = _narrow(V, F, boundary, float(tol), int(max_iter), delaunay_tol)
+    else:
+        V1, F1, info = harmonic_iteration(V, F, boundary, flip=True, tol=tol, max_iter=max_iter,
+                                          delaunay_tol=delaunay_tol)
+    if throw and not info["converged"]:
+        reason = f"the iteration broke down ({info['breakdown']})" if info["breakdown"] else (
+            f"residual {info['residual']:.3e} > tol {tol:.1e} or still flipping after {info['iterations']} iterations")
+        raise ConvergenceError(f"minimal surface in the narrow sense (Fig 7.23) did not converge: {reason}; "
+                               "raise max_iter or tol, or start closer",
+                               residual=float(info["residual"]), steps=info["iterations"])
+    return V1, F1, info
+
+
+NARROW_ROUNDS = 8  # Newton solves between Fig 7.23 re-flips (minimal_surface_delaunay)
+NARROW_STEPS = 10  # Fig 7.23 steps after a Newton solve whose triangulation is not Delaunay
+NARROW_NEWTON = 20  # Newton steps per round (far from converging, Newton wanders along tangential directions)
+
+
+def _narrow(V, F, boundary, tol, max_iter, delaunay_tol):
+    """`minimal_surface_delaunay` with Newton's method: Fig 7.23 to a loose tolerance, then
+    rounds of (Newton on ∇A_T = 0, then Fig 7.23 from its solution: converged when that finds T
+    Delaunay and the residual within `tol`, else `NARROW_STEPS` re-flipping steps)."""
+    from solvers import solve
+
+    V = np.array(V, dtype=np.float64)
+    b0 = boundary_vertices(np.asarray(F.F if isinstance(F, intrinsic.Triangulation) else F), len(V)) \
+        if boundary is None else boundary_indices(boundary, len(V))
+    scale = float(np.ptp(V[b0], axis=0).max()) if b0.size else 1.0
+    loose = max(tol, LOOSE_TOL * scale)
+    V1, F1, info = harmonic_iteration(V, F, b0, flip=True, tol=loose, max_iter=min(LOOSE_ITER, max_iter),
+                                      delaunay_tol=delaunay_tol)
+    parts, budget, newton_steps = [info], max_iter - info["iterations"], 0
+    for _ in range(NARROW_ROUNDS):
+        if parts[-1]["converged"] and parts[-1]["residual"] <= tol or parts[-1]["breakdown"] is not None or budget <= 0:
+            break
+        try:
+            sol = solve(simplicial(V1, F1, b0), tol=tol, max_steps=min(NARROW_NEWTON, budget), throw=False)
+        except DDGError:  # the gluing is not a simplicial surface (a Δ-complex): Fig 7.23 alone
+            break
+        steps = int(sol.steps)
+        newton_steps, budget = newton_steps + steps, budget - steps
+        if not np.all(np.isfinite(np.asarray(sol.x))):
+            break
+        V1, F1, info = harmonic_iteration(np.asarray(sol.x), F1, b0, flip=True, tol=tol,
+                                          max_iter=min(NARROW_STEPS, max(budget, 0)), delaunay_tol=delaunay_tol)
+        budget -= info["iterations"]
+        parts.append(info)
+    return V1, F1, _joined(parts, newton_steps, tol)
+
+
+def _joined(parts: list[dict], newton_steps: int, tol: float) -> dict:
+    """The info of consecutive `harmonic_iteration` runs as one run, with `newton_iterations`;
+    converged when the last run ended Delaunay within `tol` (the first ran to a looser one)."""
+    last = parts[-1]
+    info = dict(last, converged=bool(last["converged"] and last["residual"] <= tol))
+    for key in ("history", "flips", "area"):
+        info[key] = np.concatenate([p[key] for p in parts])
+    info["iterations"] = sum(p["iterations"] for p in parts) + newton_steps
+    info["newton_iterations"] = newton_steps
+    return info
 
 
 def _newton(V, F, b, tol, max_iter, solve_method="auto", **kwargs):
@@ -338,7 +415,8 @@ def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1
     local *minimum* of the area on the returned triangulation, never a saddle, converged to
     `tol`), `"cotan"` (Fig 6.5,
     Pinkall–Polthier alone: fast to ~1e-5, then creeping), `"delaunay"` (Fig 7.23, a minimal
-    surface in the narrow sense; `delaunay_tol=` the flips' tie tolerance) or `"newton"`
+    surface in the narrow sense, accelerated by Newton: `minimal_surface_delaunay`;
+    `delaunay_tol=` the flips' tie tolerance, `newton=False` the plain iteration) or `"newton"`
     (`solvers.solve` on `simplicial`, a critical point of any index; `solve_method=` is solve's
     `method`, other `kwargs` go to `solve`); `tol`: stop when the max-norm of the area gradient
     at the interior vertices is `<= tol`; `max_iter`: iterations (both phases of `"auto"`
@@ -367,10 +445,12 @@ def minimal_surface(V, F, boundary=None, *, method: str = "auto", tol: float = 1
         V, F, b = _checked(V, F, boundary)
         V_min, F, info = _newton(V, F, b, float(tol), int(max_iter), **kwargs)
     else:
-        if set(kwargs) - {"delaunay_tol"} or (kwargs and method == "cotan"):
+        if set(kwargs) - {"delaunay_tol", "newton"} or (kwargs and method == "cotan"):
             raise InvalidInputError(f"method={method!r} takes no further options, got {sorted(kwargs)}")
-        return harmonic_iteration(V, F, boundary, flip=method == "delaunay", tol=float(tol), max_iter=int(max_iter),
-                                  throw=throw, **kwargs)
+        if method == "delaunay":
+            return minimal_surface_delaunay(V, F, boundary, tol=float(tol), max_iter=int(max_iter), throw=throw,
+                                            **kwargs)
+        return harmonic_iteration(V, F, boundary, flip=False, tol=float(tol), max_iter=int(max_iter), throw=throw)
     if throw and not info["converged"]:
         raise ConvergenceError(
             f"minimal_surface(method={method!r}) did not converge: area-gradient residual "
