@@ -20,9 +20,10 @@ demo: $(STAMP)
 examples: $(STAMP)
 	for script in examples/[!_]*.py; do echo "== $$script"; $(PY) $$script --out report/examples || exit 1; done
 
-# one pytest worker per core (pytest-xdist), tests handed out one by one: 13 → 9 minutes on 2 cores
+# one pytest worker per core (pytest-xdist); the longest modules first (tests/conftest.py), and a
+# worker that runs out of tests takes half of the other's queue (worksteal)
 test: $(STAMP)
-	$(PY) -m pytest -q -n auto --dist load
+	$(PY) -m pytest -q -n auto --dist worksteal
 
 test-all: $(STAMP)
 	$(PY) -m pytest -q -m ''

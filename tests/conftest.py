@@ -42,3 +42,19 @@ def _release_compiled_programs():
 @pytest.fixture
 def rng():
     return np.random.default_rng(1234)
+
+
+HEAVY_FIRST = ("test_docs.py", "test_verify_checks.py", "test_sweep.py", "test_willmore.py", "test_multiprocess.py",
+               "test_rod.py", "test_subdivision.py", "test_named_constraints.py")
+"""Modules holding the suite's longest tests (`--durations=15`), run first: pytest-xdist hands
+the first tests out in turn to its workers and the rest one by one as they finish, so long tests
+at the end would leave one worker running alone.  Whole modules move, in their own order, so
+that their module fixtures are built once per worker."""
+
+
+def pytest_collection_modifyitems(items):
+    def rank(item) -> int:
+        name = item.path.name
+        return HEAVY_FIRST.index(name) if name in HEAVY_FIRST else len(HEAVY_FIRST)
+
+    items.sort(key=rank)  # stable: the order within a module and among the others is kept

@@ -4,7 +4,6 @@ its finished members; failures are recorded, not raised; another grid on the sam
 refused; `ddgjax sweep` on the command line."""
 
 import dataclasses
-import time
 
 import h5py
 import jax
@@ -35,23 +34,17 @@ def grid():
 
 @pytest.fixture(scope="module")
 def cold(problem, grid, tmp_path_factory):
-    """`(path, seconds)`: the sweep with every member started from `problem.x0`."""
+    """The file of the sweep with every member started from `problem.x0`."""
     path = tmp_path_factory.mktemp("sweep") / "cold.h5"
-    sweep.run(problem, grid, path, chunk=CHUNK, warm_start=None, progress=False)  # compiles
-    path.unlink()
-    start = time.perf_counter()
     sweep.run(problem, grid, path, chunk=CHUNK, warm_start=None, progress=False)
-    return path, time.perf_counter() - start
+    return path
 
 
 @pytest.fixture(scope="module")
 def loop(problem, grid):
-    """`(solutions, seconds)`: a loop of `solve`, one call per member, from `problem.x0`."""
+    """A loop of `solve`, one call per member, from `problem.x0` (speed: `benchmarks/sweep.py`)."""
     member = lambda c: problem.with_params({**problem.params, "chord": c})  # noqa: E731
-    solve(member(grid["chord"][0]), throw=False)  # compiles
-    start = time.perf_counter()
-    solutions = [solve(member(c), throw=False) for c in grid["chord"]]
-    return solutions, time.perf_counter() - start
+    return [solve(member(c), throw=False) for c in grid["chord"]]
 
 
 @pytest.fixture(scope="module")
@@ -75,29 +68,27 @@ def _results(data: dict) -> dict:
 
 
 def test_sweep_equals_a_loop_of_solve(cold, loop):
-    data = sweep.read(cold[0])
-    solutions, seconds = loop
+    data = sweep.read(cold)
+    solutions = loop
     for k in range(MEMBERS):  # the infeasible member too: the same last iterate
         sol = solutions[k]
         assert bool(sol.converged) == data["converged"][k] == (k != INFEASIBLE)
         assert _max_diff(data["x"][k], sol.x) <= 1e-10
         assert _max_diff({n: v[k] for n, v in data["multipliers"].items()}, sol.multipliers) <= 1e-10
         assert abs(data["energy"][k] - float(sol.energy)) <= 1e-10 and data["steps"][k] == int(sol.steps)
-    print(f"\nsweep {MEMBERS / cold[1]:.1f} members/s, loop of solve {MEMBERS / seconds:.1f} members/s, "
-          f"file {cold[0].stat().st_size} bytes")
 
 
 def test_infeasible_member_is_recorded_failed_the_others_converge(cold):
-    data = sweep.read(cold[0])
+    data = sweep.read(cold)
     assert data["done"].all()
     assert np.flatnonzero(~data["converged"]).tolist() == [INFEASIBLE]
     assert data["error"][INFEASIBLE].startswith("did not converge") and "KKT residual" in data["error"][INFEASIBLE]
     assert all(e == "" for k, e in enumerate(data["error"]) if k != INFEASIBLE)
-    assert sweep.summary(cold[0]) == {"members": MEMBERS, "done": MEMBERS, "converged": MEMBERS - 1, "failed": 1}
+    assert sweep.summary(cold) == {"members": MEMBERS, "done": MEMBERS, "converged": MEMBERS - 1, "failed": 1}
 
 
 def test_read_returns_the_documented_arrays(cold, grid):
-    data = sweep.read(cold[0])
+    data = sweep.read(cold)
     assert data["x"].shape == (MEMBERS, N, 3) and data["x"].dtype == np.float64
     assert data["multipliers"]["chord"].shape == (MEMBERS, 3) and data["multipliers"]["unit"].shape == (MEMBERS, N - 2)
     for name, dtype in [("energy", np.float64), ("residual", np.float64), ("steps", np.int64), ("status", np.int64),
@@ -141,7 +132,7 @@ def test_a_killed_sweep_resumes_without_recomputing_finished_members(problem, gr
     resumed = sweep.read(path)
     assert resumed["done"].all()
 
-    whole = sweep.read(cold[0] if warm_start is None else warm[0])  # uninterrupted
+    whole = sweep.read(cold if warm_start is None else warm[0])  # uninterrupted
     assert _max_diff(_results(resumed), _results(whole)) == 0.0 and resumed["error"].tolist() == whole["error"].tolist()
 
     again = _Counting()  # negative control: a finished sweep solves nothing
@@ -151,7 +142,7 @@ def test_a_killed_sweep_resumes_without_recomputing_finished_members(problem, gr
 
 
 def test_warm_start_previous_starts_a_chunk_from_the_last_converged_member(problem, cold, warm):
-    (path, x0s), cold_data = warm, sweep.read(cold[0])
+    (path, x0s), cold_data = warm, sweep.read(cold)
     data = sweep.read(path)
     assert len(x0s) == 3 and np.array_equal(x0s[0], np.asarray(problem.x0))
     # chunk 1 starts from member 6: member 7, the last of chunk 0, failed
@@ -187,7 +178,8 @@ def test_a_chunk_that_raises_is_solved_member_by_member(problem, tmp_path, monke
 
 
 def test_another_grid_or_problem_on_the_same_file_is_refused(problem, grid, cold):
-    path, before = cold[0], cold[0].read_bytes()
+    path = cold
+    before = path.read_bytes()
     other = {"chord": grid["chord"].copy()}
     other["chord"][3, 0] += 1e-3
     with pytest.raises(InvalidInputError, match="different grid"):
