@@ -46,10 +46,11 @@ def rng():
 
 HEAVY_FIRST = ("test_docs.py", "test_verify_checks.py", "test_sweep.py", "test_willmore.py", "test_multiprocess.py",
                "test_rod.py", "test_subdivision.py", "test_named_constraints.py")
-"""Modules holding the suite's longest tests (`--durations=15`), run first: pytest-xdist hands
-the first tests out in turn to its workers and the rest one by one as they finish, so long tests
-at the end would leave one worker running alone.  Whole modules move, in their own order, so
-that their module fixtures are built once per worker."""
+"""Modules holding the suite's longest tests (`--durations=15`), run first.  `make test` uses
+pytest-xdist's worksteal: each worker starts on a contiguous part of the collection and one that
+runs out takes half of the other's remaining queue, so long tests at the end would leave one
+worker running alone while short ones at the end are easily shared.  Whole modules move, in
+their own order, so that their module fixtures are built once per worker."""
 
 
 def pytest_collection_modifyitems(items):
