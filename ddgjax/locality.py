@@ -23,6 +23,7 @@ The unknown `x` of a local problem is a single array of shape (N, d) or (N,).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -34,6 +35,28 @@ from jaxtyping import Array, Int
 from .errors import InvalidInputError, ShapeError
 
 __all__ = ["Term", "Local", "local_sum", "local_map", "concat"]
+
+
+_JITTED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def jitted_density(fn: Callable) -> Callable:
+    """`jax.jit(fn)`, one per density function (kept while `fn` lives).
+
+    A cell density is traced once per process and cell shape, whatever the mesh: every solve,
+    gradient, Hessian block and Jacobian of every problem declared with `fn` reuses its jaxpr
+    (JAX caches the JVP, transpose and batching of a jitted function by its jaxpr), instead of
+    tracing the Python density again inside each compiled program.  XLA inlines the call, so the
+    compiled code is the same.
+    """
+    try:
+        return _JITTED[fn]
+    except KeyError:
+        pass
+    except TypeError:  # a callable without weak references: jitted anew each time
+        return jax.jit(fn)
+    _JITTED[fn] = jitted = jax.jit(fn)
+    return jitted
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,9 +76,10 @@ class Term:
 
     def cell(self, x_local, k_data, params) -> Array:
         """The density of one cell."""
+        fn = jitted_density(self.fn)
         if self.data is None:
-            return self.fn(x_local, params)
-        return self.fn(x_local, k_data, params)
+            return fn(x_local, params)
+        return fn(x_local, k_data, params)
 
     def __call__(self, x, params) -> Array:
         vals = jax.vmap(lambda xl, dk: self.cell(xl, dk, params))(x[self.stencil], self.data)
