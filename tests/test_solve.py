@@ -212,6 +212,26 @@ def test_lbfgs_method_solves_minimisation_alone():
     np.testing.assert_allclose(float(sol.multipliers[0]), 1 - np.linalg.norm(c) / 1.5, atol=1e-9)
 
 
+def test_lbfgs_stops_when_no_critical_point_is_near():
+    """Two parallel planes x₀ = 1 and x₀ = 2 admit no point: the augmented Lagrangian stops once
+    STALL_OUTER outer steps have not lowered the residual, long before `max_steps` (the bound it
+    ran to before); a feasible problem with the same budget converges (the control)."""
+    from solvers._first_order import STALL_OUTER
+
+    def parallel_planes(x, params):
+        return jnp.stack([x[0] - 1.0, x[0] - params["b"]])
+
+    def energy(x, params):
+        return jnp.sum(x**2)
+
+    infeasible = dg.Problem(energy, np.zeros(3), constraints=parallel_planes, params={"b": 2.0})
+    sol = solve(infeasible, method="lbfgs", max_steps=200, throw=False)
+    assert not bool(sol.converged)
+    assert STALL_OUTER <= int(sol.steps) <= 4 * STALL_OUTER
+    feasible = solve(infeasible.with_params({"b": 1.0}), method="lbfgs", max_steps=200, throw=False)
+    assert float(feasible.residual) <= 1e-10 and int(feasible.steps) < 4 * STALL_OUTER
+
+
 def test_warm_start_reaches_minimum_from_far_away():
     """Six charges: L-BFGS phase then Newton; the minimum is the octahedron, E = 3/2 + 12/√2."""
     sol = solve(_thomson(6, 11), warm_start="lbfgs")
