@@ -59,6 +59,40 @@ def jitted_density(fn: Callable) -> Callable:
     return jitted
 
 
+def _cell_value(fn: Callable, x_local, data_k, params, weights_k):
+    """The density of one cell flattened, or the scalar `−w_k · g_k` when weights `w_k` are given."""
+    value = jnp.ravel(fn(x_local, params) if data_k is None else fn(x_local, data_k, params))
+    return value if weights_k is None else -jnp.dot(weights_k, value)
+
+
+def _cell_scalar(fn: Callable, x_local, data_k, params, weights_k):
+    """`e_k`: a scalar density's value, or `−w_k · g_k` for a vector one with weights `w_k`."""
+    value = _cell_value(fn, x_local, data_k, params, weights_k)
+    return value[0] if weights_k is None else value
+
+
+_DERIVATIVES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _jitted_cell_derivative(fn: Callable, kind: str) -> Callable:
+    """`jax.jit(vmap(derivative))` over cells of `fn`'s Hessian (`kind="hessian"`) or Jacobian
+    (`"jacobian"`), one per density function: traced once per process and chunk shape, and
+    reused by every compiled program that assembles a KKT matrix or a constraint Jacobian."""
+    make = {
+        "hessian": lambda: jax.vmap(jax.hessian(lambda xl, dk, p, wk: _cell_scalar(fn, xl, dk, p, wk)),
+                                    in_axes=(0, 0, None, 0)),
+        "jacobian": lambda: jax.vmap(jax.jacfwd(lambda xl, dk, p: _cell_value(fn, xl, dk, p, None)),
+                                     in_axes=(0, 0, None)),
+    }[kind]
+    try:
+        per_fn = _DERIVATIVES.setdefault(fn, {})
+    except TypeError:  # a callable without weak references: jitted anew each time
+        return jax.jit(make())
+    if kind not in per_fn:
+        per_fn[kind] = jax.jit(make())
+    return per_fn[kind]
+
+
 @dataclass(frozen=True, eq=False)
 class Term:
     """One local density `fn` evaluated on every row `k` of `stencil`.
@@ -80,6 +114,17 @@ class Term:
         if self.data is None:
             return fn(x_local, params)
         return fn(x_local, k_data, params)
+
+    def hessians(self, x_cells, data, params, weights=None) -> Array:
+        """∇²e_k with respect to `x_local` for every cell k of a chunk: `x_cells` (K, s, d),
+        `data` the cells' data (K, ...), `weights` None for a scalar density (`e_k` its value) or
+        (K, c) for a vector one (`e_k = −w_k · g_k`, the constraint part of the Lagrangian's
+        Hessian).  Shape (K, s, d, s, d)."""
+        return _jitted_cell_derivative(self.fn, "hessian")(x_cells, data, params, weights)
+
+    def jacobians(self, x_cells, data, params) -> Array:
+        """∂g_k/∂x_local for every cell k: shape (K, c, s, d) for `x_cells` (K, s, d)."""
+        return _jitted_cell_derivative(self.fn, "jacobian")(x_cells, data, params)
 
     def __call__(self, x, params) -> Array:
         vals = jax.vmap(lambda xl, dk: self.cell(xl, dk, params))(x[self.stencil], self.data)

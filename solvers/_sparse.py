@@ -319,14 +319,9 @@ def _add_cell_hessians(K, term: Term, x, params, cells, targets, lam=None, rows=
     """K + Σ_k P_kᵀ ∇²e_k P_k over the term's cells, chunk by chunk (`cells`, `targets`, `rows`
     from `_hessian_chunks`); for a constraint term `e_k = −λ_{rows_k} · g_k`."""
 
-    def cell_value(xl, dk, wk):
-        val = jnp.ravel(term.cell(xl, dk, params))
-        return val[0] if wk is None else -jnp.dot(wk, val)
-
     def add_chunk(K, chunk):
         st, tg, dk, rk = chunk
-        weights = None if rk is None else lam[rk]
-        H = jax.vmap(jax.hessian(cell_value), in_axes=(0, 0, 0))(x[st], dk, weights)
+        H = term.hessians(x[st], dk, params, None if rk is None else lam[rk])
         return K.at[tg.reshape(-1)].add(H.reshape(-1)), None
 
     chunks = cells.shape[0]
@@ -337,9 +332,7 @@ def _add_cell_hessians(K, term: Term, x, params, cells, targets, lam=None, rows=
 
 
 def _cell_jacobians(term: Term, x, params):
-    local = x[term.stencil]
-    J = jax.vmap(jax.jacfwd(lambda xl, dk: jnp.ravel(term.cell(xl, dk, params))))(local, term.data)
-    return J.reshape(-1)
+    return term.jacobians(x[term.stencil], term.data, params).reshape(-1)
 
 
 def kkt_values(pattern: SparsePattern, index: dict, kkt: KKT, w, identity_hessian: bool = False):
