@@ -71,26 +71,69 @@ def _cell_scalar(fn: Callable, x_local, data_k, params, weights_k):
     return value[0] if weights_k is None else value
 
 
-_DERIVATIVES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+def _per_cell(fn: Callable, kind: str) -> Callable:
+    """Of one cell of density `fn`, as a function of `(x_local, data_k, params, weights_k)`: its
+    value (`kind="value"`), the Hessian ∇²e_k of `e_k` (`"hessian"`, `_cell_scalar`) or the
+    Jacobian of its flattened value (`"jacobian"`), with respect to `x_local`."""
+    if kind == "value":
+        return lambda xl, dk, p, wk: fn(xl, p) if dk is None else fn(xl, dk, p)
+    if kind == "hessian":
+        return jax.hessian(lambda xl, dk, p, wk: _cell_scalar(fn, xl, dk, p, wk))
+    jacobian = jax.jacfwd(lambda xl, dk, p: _cell_value(fn, xl, dk, p, None))
+    return lambda xl, dk, p, wk: jacobian(xl, dk, p)
 
 
-def _jitted_cell_derivative(fn: Callable, kind: str) -> Callable:
-    """`jax.jit(vmap(derivative))` over cells of `fn`'s Hessian (`kind="hessian"`) or Jacobian
-    (`"jacobian"`), one per density function: traced once per process and chunk shape, and
-    reused by every compiled program that assembles a KKT matrix or a constraint Jacobian."""
-    make = {
-        "hessian": lambda: jax.vmap(jax.hessian(lambda xl, dk, p, wk: _cell_scalar(fn, xl, dk, p, wk)),
-                                    in_axes=(0, 0, None, 0)),
-        "jacobian": lambda: jax.vmap(jax.jacfwd(lambda xl, dk, p: _cell_value(fn, xl, dk, p, None)),
-                                     in_axes=(0, 0, None)),
-    }[kind]
+_BATCHED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _batched(fn: Callable, kind: str) -> Callable:
+    """`jax.jit(vmap(per-cell kind))` over a leading axis of cells, one per density function and
+    kind (`_per_cell`): traced, differentiated and batched once per process and bucket of cells
+    (`cell_bucket`), and reused by every compiled program that evaluates the term."""
+    def make():
+        return jax.jit(jax.vmap(_per_cell(fn, kind), in_axes=(0, 0, None, 0)))
+
     try:
-        per_fn = _DERIVATIVES.setdefault(fn, {})
+        per_fn = _BATCHED.setdefault(fn, {})
     except TypeError:  # a callable without weak references: jitted anew each time
-        return jax.jit(make())
+        return make()
     if kind not in per_fn:
-        per_fn[kind] = jax.jit(make())
+        per_fn[kind] = make()
     return per_fn[kind]
+
+
+CELL_BUCKETS = (32, 128, 512, 2048)
+"""Numbers of cells a density is evaluated on at once: a term of K cells is padded (with copies
+of its first cell, whose values are dropped) to the first bucket ≥ K, so that meshes and curves
+of similar sizes (a convergence study's n = 8, 16; an icosphere's levels 0 and 1) share the
+traced and batched derivatives of the density.  Beyond the last bucket K itself is used: a large
+problem compiles its own program anyway and padding would cost run time."""
+
+
+def cell_bucket(cells: int) -> int:
+    """The first of `CELL_BUCKETS` ≥ `cells`, or `cells` beyond the last."""
+    return next((b for b in CELL_BUCKETS if b >= cells), cells)
+
+
+def _padded(tree, cells: int):
+    """Every leaf's leading axis padded from its length K to `cells` with copies of its row 0."""
+    def pad(a):
+        extra = cells - a.shape[0]
+        if extra == 0:
+            return a
+        xp = np if isinstance(a, np.ndarray) else jnp
+        return xp.concatenate([a, xp.repeat(a[:1], extra, axis=0)])
+
+    return jax.tree_util.tree_map(pad, tree)
+
+
+def _on_cells(fn: Callable, kind: str, x_cells, data, params, weights=None) -> Array:
+    """The batched `kind` of density `fn` on K cells (`x_cells` (K, ...), `data` and `weights`
+    with K rows), evaluated on the cells padded to `cell_bucket(K)`; K rows out."""
+    cells = x_cells.shape[0]
+    bucket = cell_bucket(cells)
+    out = _batched(fn, kind)(*_padded((x_cells, data), bucket), params, _padded(weights, bucket))
+    return jax.tree_util.tree_map(lambda a: a[:cells], out) if bucket != cells else out
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,14 +163,14 @@ class Term:
         `data` the cells' data (K, ...), `weights` None for a scalar density (`e_k` its value) or
         (K, c) for a vector one (`e_k = −w_k · g_k`, the constraint part of the Lagrangian's
         Hessian).  Shape (K, s, d, s, d)."""
-        return _jitted_cell_derivative(self.fn, "hessian")(x_cells, data, params, weights)
+        return _on_cells(self.fn, "hessian", x_cells, data, params, weights)
 
     def jacobians(self, x_cells, data, params) -> Array:
         """∂g_k/∂x_local for every cell k: shape (K, c, s, d) for `x_cells` (K, s, d)."""
-        return _jitted_cell_derivative(self.fn, "jacobian")(x_cells, data, params)
+        return _on_cells(self.fn, "jacobian", x_cells, data, params)
 
     def __call__(self, x, params) -> Array:
-        vals = jax.vmap(lambda xl, dk: self.cell(xl, dk, params))(x[self.stencil], self.data)
+        vals = _on_cells(self.fn, "value", x[self.stencil], self.data, params)
         return vals.sum(axis=0) if self.reduce == "sum" else vals.reshape(-1)
 
     def key(self) -> tuple:
