@@ -102,12 +102,13 @@ def _batched(fn: Callable, kind: str) -> Callable:
     return per_fn[kind]
 
 
-CELL_BUCKETS = (32, 128, 512, 2048)
+CELL_BUCKETS = (32, 128)
 """Numbers of cells a density is evaluated on at once: a term of K cells is padded (with copies
-of its first cell, whose values are dropped) to the first bucket ≥ K, so that meshes and curves
-of similar sizes (a convergence study's n = 8, 16; an icosphere's levels 0 and 1) share the
-traced and batched derivatives of the density.  Beyond the last bucket K itself is used: a large
-problem compiles its own program anyway and padding would cost run time."""
+of its first cell, whose values are dropped) to the first bucket ≥ K, so that small problems of
+nearby sizes (a convergence study's curves of n = 8, 16, 32 edges; a torus of revolution's 12,
+16, 24 profile points) share the traced and batched derivatives of the density.  Beyond the
+last bucket K itself is used: a larger problem compiles its own program anyway, and padding
+would multiply the density's evaluations in every Newton step (up to 4×)."""
 
 
 def cell_bucket(cells: int) -> int:

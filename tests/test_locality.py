@@ -58,7 +58,7 @@ def test_padded_cells_give_the_cells_values_and_derivatives(cells):
 
 def test_buckets_are_increasing_and_cover_every_size():
     assert list(locality.CELL_BUCKETS) == sorted(locality.CELL_BUCKETS)
-    assert [locality.cell_bucket(k) for k in (1, 32, 33, 2048, 2049)] == [32, 32, 128, 2048, 2049]
+    assert [locality.cell_bucket(k) for k in (1, 32, 33, 128, 129)] == [32, 32, 128, 128, 129]
 
 
 def test_sizes_in_one_bucket_share_the_traced_density_and_another_bucket_traces_again():
