@@ -184,12 +184,18 @@ def discrete_errors(problem, solution, smooth: SmoothRod) -> dict[str, float]:
     Phi, h = jnp.asarray(solution.x), problem.params["h"]
     n = Phi.shape[0]
     _, gamma = sample(smooth, np.arange(n + 1) * h)
+    position, load, mean_twist = _distances(Phi, jnp.asarray(h, dtype=float), gamma, solution.multipliers["chord"],
+                                            smooth.a)
+    return {"position": float(position), "load": float(load), "twist": abs(float(mean_twist) / h - torsion(smooth))}
+
+
+@jax.jit
+def _distances(Phi, h, gamma, chord_multipliers, a):
+    """max_k |γ_k − γ(kh)|, max |λ − a| and mean θ_k of `discrete_errors`, in one compiled program
+    per size (not one per array operation)."""
     nodes = from_tangents(qt.rotate(Phi, E1), edge_length=h)
-    return {
-        "position": float(jnp.max(jnp.linalg.norm(nodes - gamma, axis=1))),
-        "load": float(jnp.max(jnp.abs(solution.multipliers["chord"] - smooth.a))),
-        "twist": abs(float(jnp.mean(edge_frame_split(Phi)[1])) / h - torsion(smooth)),
-    }
+    return (jnp.max(jnp.linalg.norm(nodes - gamma, axis=1)), jnp.max(jnp.abs(chord_multipliers - a)),
+            jnp.mean(edge_frame_split(Phi)[1]))
 
 
 def sample(rod: SmoothRod, s) -> tuple[Float[Array, "m 4"], Float[Array, "m 3"]]:
@@ -254,7 +260,13 @@ def discrete_top_residual(Phi: Float[Array, "n 4"], h: float, alpha: float, a) -
     `ω = (ω_k + ω_{k+1})/2`, `ω' = (ω_{k+1} − ω_k)/h`, `τ = <ω, T_k>`.  Both rows of the result
     are O(h²) on samples of a smooth rod (Thm 3.11: a rod's frame is a top motion).
     """
-    Phi = jnp.asarray(Phi, dtype=float)
+    return _top_residual(jnp.asarray(Phi, dtype=float), jnp.asarray(h, dtype=float), jnp.asarray(alpha, dtype=float),
+                         jnp.asarray(a, dtype=float))
+
+
+@jax.jit
+def _top_residual(Phi, h, alpha, a):
+    """`discrete_top_residual`, one compiled program per size."""
     T = qt.rotate(Phi, E1)
     omega = 2 * qt.log(qt.mul(Phi[1:], qt.conj(Phi[:-1]))) / h
     Tv = T[:-1] + T[1:]
@@ -265,5 +277,5 @@ def discrete_top_residual(Phi: Float[Array, "n 4"], h: float, alpha: float, a) -
     dw = (omega[1:] - omega[:-1]) / h
     tau = jnp.sum(w * Te, axis=-1, keepdims=True)
     r1 = dT - jnp.cross(w, Te)
-    r2 = dw - (1 - alpha) * tau * dT - jnp.cross(Te, jnp.asarray(a, dtype=float))
+    r2 = dw - (1 - alpha) * tau * dT - jnp.cross(Te, a)
     return jnp.stack([r1, r2], axis=1)
