@@ -37,31 +37,29 @@ from .errors import InvalidInputError, ShapeError
 __all__ = ["Term", "Local", "local_sum", "local_map", "concat"]
 
 
-_JITTED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_PER_FUNCTION: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def jitted_density(fn: Callable) -> Callable:
-    """`jax.jit(fn)`, one per density function (kept while `fn` lives).
-
-    A cell density is traced once per process and cell shape, whatever the mesh: every solve,
-    gradient, Hessian block and Jacobian of every problem declared with `fn` reuses its jaxpr
-    (JAX caches the JVP, transpose and batching of a jitted function by its jaxpr), instead of
-    tracing the Python density again inside each compiled program.  XLA inlines the call, so the
-    compiled code is the same.
-    """
+def _per_function(fn: Callable, kind: str, make: Callable[[], Callable]) -> Callable:
+    """`make()`, made once per density function `fn` and `kind` (kept while `fn` lives; made
+    anew each time for a callable without weak references)."""
     try:
-        return _JITTED[fn]
-    except KeyError:
-        pass
-    except TypeError:  # a callable without weak references: jitted anew each time
-        return jax.jit(fn)
-    _JITTED[fn] = jitted = jax.jit(fn)
-    return jitted
+        made = _PER_FUNCTION.setdefault(fn, {})
+    except TypeError:
+        return make()
+    if kind not in made:
+        made[kind] = make()
+    return made[kind]
+
+
+def _density(fn: Callable, x_local, data_k, params):
+    """`fn(x_local, params)`, or `fn(x_local, data_k, params)` for a term with data."""
+    return fn(x_local, params) if data_k is None else fn(x_local, data_k, params)
 
 
 def _cell_value(fn: Callable, x_local, data_k, params, weights_k):
     """The density of one cell flattened, or the scalar `−w_k · g_k` when weights `w_k` are given."""
-    value = jnp.ravel(fn(x_local, params) if data_k is None else fn(x_local, data_k, params))
+    value = jnp.ravel(_density(fn, x_local, data_k, params))
     return value if weights_k is None else -jnp.dot(weights_k, value)
 
 
@@ -76,30 +74,18 @@ def _per_cell(fn: Callable, kind: str) -> Callable:
     value (`kind="value"`), the Hessian ∇²e_k of `e_k` (`"hessian"`, `_cell_scalar`) or the
     Jacobian of its flattened value (`"jacobian"`), with respect to `x_local`."""
     if kind == "value":
-        return lambda xl, dk, p, wk: fn(xl, p) if dk is None else fn(xl, dk, p)
+        return lambda xl, dk, p, wk: _density(fn, xl, dk, p)
     if kind == "hessian":
         return jax.hessian(lambda xl, dk, p, wk: _cell_scalar(fn, xl, dk, p, wk))
     jacobian = jax.jacfwd(lambda xl, dk, p: _cell_value(fn, xl, dk, p, None))
     return lambda xl, dk, p, wk: jacobian(xl, dk, p)
 
 
-_BATCHED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
 def _batched(fn: Callable, kind: str) -> Callable:
     """`jax.jit(vmap(per-cell kind))` over a leading axis of cells, one per density function and
     kind (`_per_cell`): traced, differentiated and batched once per process and bucket of cells
     (`cell_bucket`), and reused by every compiled program that evaluates the term."""
-    def make():
-        return jax.jit(jax.vmap(_per_cell(fn, kind), in_axes=(0, 0, None, 0)))
-
-    try:
-        per_fn = _BATCHED.setdefault(fn, {})
-    except TypeError:  # a callable without weak references: jitted anew each time
-        return make()
-    if kind not in per_fn:
-        per_fn[kind] = make()
-    return per_fn[kind]
+    return _per_function(fn, kind, lambda: jax.jit(jax.vmap(_per_cell(fn, kind), in_axes=(0, 0, None, 0))))
 
 
 CELL_BUCKETS = (32, 128)
@@ -154,10 +140,7 @@ class Term:
 
     def cell(self, x_local, k_data, params) -> Array:
         """The density of one cell."""
-        fn = jitted_density(self.fn)
-        if self.data is None:
-            return fn(x_local, params)
-        return fn(x_local, k_data, params)
+        return _density(self.fn, x_local, None if self.data is None else k_data, params)
 
     def hessians(self, x_cells, data, params, weights=None) -> Array:
         """∇²e_k with respect to `x_local` for every cell k of a chunk: `x_cells` (K, s, d),
