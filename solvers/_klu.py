@@ -4,7 +4,10 @@ Inside `jit`, `vmap`-able (a loop of factorisations), CPU only.  KLU orders for 
 matrices (block triangular form, then AMD on each block) and factorises left-looking without
 supernodes: the fastest choice for chains (curves, rods), where the KKT matrix is banded and
 fill is nil, but not for the 2-D fill of a mesh (`SparseLDL` there).  A constraint summed over
-all cells (a chord) is eliminated by its Schur complement (`_sparse.Bordered`).
+all cells (a chord) is eliminated by its Schur complement (`_sparse.Bordered`).  `apply`
+factorises and solves in one call; `factorised` factorises once for the several solves of a
+Newton step (a solve with the factors costs a fraction of a factorisation) and frees the
+factors after.
 Its Levenberg–Marquardt step is one complex solve with `K + i√ν I`, on K's own pattern and
 KLU analysis.
 """
@@ -46,20 +49,94 @@ def symbolic_handle(pattern: SparsePattern | Bordered) -> jax.Array:
         return jax.device_put(np.uint64(pattern.symbolic().raw))
 
 
-def _bordered_solve(split, index: dict, values, b):
-    """Solve `[[A, B], [Bᵗ, C]] x = b` through the Schur complement of the border (`Bordered`);
-    `index` holds its arrays (`split_*`), `split` the sizes and KLU's analysis of A."""
+def _klu_factor(rows, cols, values, handle):
+    """KLU's numeric factorisation (partial pivoting, on the analysis `handle`) of the matrix with
+    sorted COO indices (rows, cols) and `values`: a (1,) uint64 address of the factors, to be
+    freed by `_klu_free`."""
+    import klujax
+
+    factor = klujax.factor_c128 if jnp.iscomplexobj(values) else klujax.factor_f64
+    return factor.bind(jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], handle)
+
+
+def _klu_solve_factored(numeric, b, handle):
+    """Solve with KLU's factors `numeric` (`_klu_factor`): two triangular solves."""
+    import klujax
+
+    solve = klujax.solve_with_numeric_c128 if jnp.iscomplexobj(b) else klujax.solve_with_numeric_f64
+    return solve.bind(handle, numeric, b.reshape(1, b.shape[0], -1)).reshape(b.shape)
+
+
+FREE_NUMERIC = "ddgjax_klu_free_numeric"
+_REGISTERED: set = set()  # FFI targets registered in this process
+
+
+def _klu_free(numeric, after) -> None:
+    """Free KLU's factors `numeric` once `after` (a pytree) is computed.
+
+    klujax frees factors made outside a trace when their Python object dies; inside a compiled
+    program they are freed here, by klujax's own `free_numeric` handler (which frees every
+    address in its operand), left unregistered by its Python side.  The free must follow
+    every solve with the factors, so its operand is made to depend on all of `after`
+    (`_depending_on`).  Under `vmap` a batch of factors is freed by one call, and factors
+    shared by the batch (a matrix that does not depend on the batched values) once."""
+    import klujax_cpp
+
+    if FREE_NUMERIC not in _REGISTERED:
+        jax.ffi.register_ffi_target(FREE_NUMERIC, klujax_cpp.free_numeric(), platform="cpu")
+        _REGISTERED.add(FREE_NUMERIC)
+    _free_after(numeric, after)
+
+
+@jax.custom_batching.custom_vmap
+def _free_after(numeric, after):
+    free = jax.ffi.ffi_call(FREE_NUMERIC, jax.ShapeDtypeStruct((), jnp.int32), has_side_effect=True)
+    return free(_depending_on(numeric, after))
+
+
+@_free_after.def_vmap
+def _free_after_batched(axis_size, in_batched, numeric, after):
+    """Batched factors are freed together, factors shared by the batch once: `_free_after` on
+    the whole arrays, whose batch axis is just another axis here."""
+    return _free_after(numeric, after), False
+
+
+def _depending_on(handle, after):
+    """`handle` plus an integer computed from every leaf of `after` that is 0 at run time
+    (`isnan(s) & isfinite(s)`) but that the compiler cannot fold: a data dependency that orders
+    what uses the result after `after`.  (An optimisation barrier does not: XLA's CPU pipeline
+    drops it.)"""
+    s = sum(jnp.sum(jnp.real(leaf).astype(jnp.float64)) for leaf in jax.tree_util.tree_leaves(after))
+    return handle + (jnp.isnan(s) & jnp.isfinite(s)).astype(handle.dtype)
+
+
+def _border_blocks(split, index: dict, values):
+    """`(B, Bᵗ, C)` of the bordered matrix `[[A, B], [Bᵗ, C]]` (`Bordered`), dense; `index`
+    holds its arrays (`split_*`)."""
     ix = {name: index[f"split_{name}"] for name in SPLIT_ARRAYS}
     n_in, p = len(split.interior), len(split.border)
     B = jnp.zeros((n_in, p), values.dtype).at[ix["b_rows"], ix["b_cols"]].add(values[ix["take_b"]])
     Bt = jnp.zeros((p, n_in), values.dtype).at[ix["bt_rows"], ix["bt_cols"]].add(values[ix["take_bt"]])
     C = jnp.zeros((p, p), values.dtype).at[ix["c_rows"], ix["c_cols"]].add(values[ix["take_c"]])
-    rhs = jnp.concatenate([b[ix["interior"]][:, None], B], axis=1)
-    Y = _klu_solve(ix["a_rows"], ix["a_cols"], values[ix["take_a"]], rhs, index["klu_symbolic"])
-    schur = C - Bt @ Y[:, 1:]
-    x_border = jnp.linalg.solve(schur, b[ix["border"]] - Bt @ Y[:, 0])
-    x_interior = Y[:, 0] - Y[:, 1:] @ x_border
-    return jnp.zeros(b.shape, values.dtype).at[ix["interior"]].set(x_interior).at[ix["border"]].set(x_border)
+    return B, Bt, C
+
+
+def _eliminate_border(index: dict, blocks, b, y, Y):
+    """The solution of `[[A, B], [Bᵗ, C]] x = b` from `y = A⁻¹ b_A` and `Y = A⁻¹ B`, by the
+    Schur complement `S = C − Bᵗ Y`: `x_C = S⁻¹ (b_C − Bᵗ y)`, `x_A = y − Y x_C`."""
+    _, Bt, C = blocks
+    interior, border = index["split_interior"], index["split_border"]
+    x_border = jnp.linalg.solve(C - Bt @ Y, b[border] - Bt @ y)
+    return jnp.zeros(b.shape, y.dtype).at[interior].set(y - Y @ x_border).at[border].set(x_border)
+
+
+def _bordered_solve(split, index: dict, values, b):
+    """Solve `[[A, B], [Bᵗ, C]] x = b` (`Bordered`): one KLU factorisation and solve of A with the
+    right-hand sides `[b_A, B]`, then `_eliminate_border`."""
+    blocks = _border_blocks(split, index, values)
+    rhs = jnp.concatenate([b[index["split_interior"]][:, None], blocks[0]], axis=1)
+    Y = _klu_solve(index["split_a_rows"], index["split_a_cols"], values[index["split_take_a"]], rhs, index["klu_symbolic"])
+    return _eliminate_border(index, blocks, b, Y[:, 0], Y[:, 1:])
 
 
 class AssembledSparse(LinearSolver):
@@ -131,6 +208,27 @@ class KLU(AssembledSparse):
         if split is not None:
             return _bordered_solve(split, self.index, fac, b)
         return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.index["klu_symbolic"])
+
+    def factorised(self, fac, use):
+        """`use(solve)` with one KLU factorisation of `fac` for all its solves (`LinearSolver`),
+        freed after; bordered: with `A⁻¹ B` made once too."""
+        ix, handle = self.index, self.index["klu_symbolic"]
+        split = self.pattern.split()
+        if split is None:
+            numeric = _klu_factor(ix["rows"], ix["cols"], fac, handle)
+            out = use(lambda b: _klu_solve_factored(numeric, b, handle))
+        else:
+            numeric = _klu_factor(ix["split_a_rows"], ix["split_a_cols"], fac[ix["split_take_a"]], handle)
+            blocks = _border_blocks(split, ix, fac)
+            Y = _klu_solve_factored(numeric, blocks[0], handle)
+
+            def solve(b):
+                y = _klu_solve_factored(numeric, b[ix["split_interior"]], handle)
+                return _eliminate_border(ix, blocks, b, y, Y)
+
+            out = use(solve)
+        _klu_free(numeric, out)
+        return out
 
     def lm_solve_matrix(self, K, nu, R):
         """`−(K² + ν I)⁻¹ K R = −Re[(K + i√ν I)⁻¹ R]` (K symmetric: `(K + isI)⁻¹ = (K − isI)(K² + s²I)⁻¹`),

@@ -21,6 +21,7 @@ its static data the jit cache key) with
 - `factor_matrix(kkt, K, mu_rel) -> fac`: `K + μS` made ready to solve with (factorised);
 - `apply(fac, b)`: solve with it (Newton's damping test reuses one factorisation);
 - `apply_refined(fac, K, b)`: the same, refined once with K when `iterative_refinement`;
+- `factorised(fac, use)`: `use(solve)` with one factorisation for all its solves;
 - `apply_transpose(fac, b)`: solve with the transpose, for the adjoint of implicit
   differentiation (`K + μS` is symmetric, so by default the same solve);
 - `matvec(K, v)`: `K v`;
@@ -88,16 +89,28 @@ class LinearSolver(abc.ABC):
 
     def apply_refined(self, fac, K, b):
         """`d = (K + μS)⁻¹ b`, then, if `iterative_refinement`, one step of iterative refinement
-        with the unregularised K: `d + (K + μS)⁻¹ (b − K d)`.
+        with the unregularised K (`refined`)."""
+        return self.refined(lambda r: self.apply(fac, r), K, b)
+
+    def refined(self, solve, K, b):
+        """`d = solve(b)`, `solve` applying `(K + μS)⁻¹`, then, if `iterative_refinement`, one
+        step of iterative refinement with the unregularised K: `d + (K + μS)⁻¹ (b − K d)`.
 
         In an eigendirection of K with eigenvalue λ the regularised solve is off by the factor
         `λ/(λ + μ)` and the refined one by `1 − μ²/(λ + μ)²`; in a null direction (λ = 0,
         where b has only round-off) the refined step is twice the regularised one.
         """
-        d = self.apply(fac, b)
+        d = solve(b)
         if not self.iterative_refinement:
             return d
-        return d + self.apply(fac, b - self.matvec(K, d))
+        return d + solve(b - self.matvec(K, d))
+
+    def factorised(self, fac, use):
+        """`use(solve)`, `solve(b) = (K + μS)⁻¹ b` with `fac = factor_matrix(...)`: for a
+        computation that solves several times with one matrix (a Newton step, its refinement and
+        its damping tests).  A back end whose `apply` factorises anew (KLU) factorises once here
+        and frees the factorisation once `use`'s result is computed."""
+        return use(lambda b: self.apply(fac, b))
 
     def apply_transpose(self, fac, b):
         """`(K + μS)ᵀ⁻¹ b`; K and S are symmetric."""

@@ -2,7 +2,7 @@
 
 Each step first tries the Newton step `Δ = −K⁻¹R` (with a regularisation μ = 1e-14 relative to
 each row of K, enough to factorise an exactly singular K, and one step of iterative refinement
-with the unregularised K: `LinearSolver.apply_refined`), damped `αΔ` with
+with the unregularised K: `LinearSolver.refined`), damped `αΔ` with
 α = 1, ½, … until Deuflhard's natural monotonicity test holds (`_step`); near a
 solution the full step is taken, so convergence is quadratic, and a quadratic program takes
 one step.
@@ -76,18 +76,22 @@ def _lm_direction(linear, K, R, theta, wanted):
 
     A loop that runs 0 or 1 times rather than `lax.cond`: under `vmap` a cond with a batched
     predicate batches all its operands, incl. the sparse index arrays, which KLU cannot take
-    batched; a while_loop keeps them unbatched."""
+    batched; a while_loop keeps them unbatched.  The loop consumes R from its state (the
+    state's R is zero after the step): a body computed from loop-invariant values only would be
+    hoisted out of the loop by XLA, and run whether wanted or not."""
     nu = theta * jnp.linalg.norm(R)
 
     def body(carry):
-        d = linear.lm_solve_matrix(K, nu, R)
-        return d, linear.matvec(K, d), jnp.asarray(False)
+        _, _, rhs, _ = carry
+        d = linear.lm_solve_matrix(K, nu, rhs)
+        return d, linear.matvec(K, d), jnp.zeros_like(rhs), jnp.asarray(False)
 
-    d, Kd, _ = jax.lax.while_loop(lambda carry: carry[2], body, (jnp.zeros_like(R), jnp.zeros_like(R), wanted))
+    zeros = jnp.zeros_like(R)
+    d, Kd, _, _ = jax.lax.while_loop(lambda carry: carry[3], body, (zeros, zeros, R, wanted))
     return d, Kd
 
 
-def _step(kkt: KKT, linear, K, w, R, theta):
+def _step(kkt: KKT, linear, K, w, R, theta, active=True):
     """One globalised step from `w`: damped Newton trials, then at most one LM trial.
 
     Newton: with the correction `Δ = −K(w)⁻¹R(w)` and, for a trial `w + αΔ`, the simplified
@@ -106,15 +110,22 @@ def _step(kkt: KKT, linear, K, w, R, theta):
 
     All trials are one loop with one evaluation of the residual, so the compiled program holds
     the residual once.  Returns `(d, R(w + d), accepted, θ, stuck)`; `K = linear.matrix(kkt, w)`.
+    With `active` False no trial is made (nothing accepted): under `vmap` the members that
+    have finished still run the step, and their trials, discarded, would keep the loop going.
     """
     fac = linear.factor_matrix(kkt, K, NEWTON_MU)
-    delta = linear.apply_refined(fac, K, -R)
+    return linear.factorised(fac, lambda solve: _trials(kkt, linear, solve, K, w, R, theta, active))
+
+
+def _trials(kkt: KKT, linear, solve, K, w, R, theta, active):
+    """The trials of `_step`, `solve` applying the factorised `(K + μS)⁻¹`."""
+    delta = linear.refined(solve, K, -R)
     size = jnp.linalg.norm(delta)
     at_roundoff = jnp.max(jnp.abs(delta)) <= ROUNDOFF * jnp.maximum(1.0, jnp.max(jnp.abs(w)))
 
     def cond(t: Trial):
         newton_left = (t.alpha > MIN_NEWTON_STEP) | ~at_roundoff
-        return ~t.ok & ~t.lm & newton_left
+        return active & ~t.ok & ~t.lm & newton_left
 
     def body(t: Trial) -> Trial:
         alpha = 0.5 * t.alpha  # the first trial is α = 1; after 2⁻¹⁰, the LM trial
@@ -122,7 +133,7 @@ def _step(kkt: KKT, linear, K, w, R, theta):
         d_lm, Kd_lm = _lm_direction(linear, K, R, t.theta, lm)
         d = jnp.where(lm, d_lm, alpha * delta)
         R_new = kkt.residual(w + d)
-        simplified = jnp.linalg.norm(linear.apply(fac, -R_new))
+        simplified = jnp.linalg.norm(solve(-R_new))
         newton_ok = jnp.isfinite(_merit(R_new)) & jnp.isfinite(simplified) & jnp.isfinite(size)
         newton_ok = newton_ok & (simplified <= (1 - alpha / 4) * size)
         predicted = _merit(R) - _merit(R + Kd_lm)  # meaningful in the LM trial only
@@ -155,7 +166,7 @@ def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> Newt
 
     def body(s: NewtonState) -> NewtonState:
         K = linear.matrix(kkt, s.w)  # the second derivatives, once per step
-        d, R_new, ok, theta, stuck = _step(kkt, linear, K, s.w, s.R, s.theta)
+        d, R_new, ok, theta, stuck = _step(kkt, linear, K, s.w, s.R, s.theta, s.status == RUNNING)
         w = jnp.where(ok, s.w + d, s.w)
         R = jnp.where(ok, R_new, s.R)
         residual = scaled_residual(R, weights, n)
