@@ -77,12 +77,32 @@ def _csc_structure(pattern: SparsePattern) -> tuple[np.ndarray, np.ndarray]:
 @functools.cache
 def pardiso_available() -> bool:
     try:
-        import pypardiso
-
-        pypardiso.PyPardisoSolver()  # finds MKL's runtime
+        pardiso_solver(11)
     except (ImportError, OSError):
         return False
     return True
+
+
+def pardiso_solver(mtype: int):
+    """A `pypardiso.PyPardisoSolver` for the matrix type `mtype` (−2: real symmetric indefinite).
+
+    pypardiso looks MKL's runtime up on every construction (`find_library`, then a recursive
+    glob of `sys.prefix`, a quarter of a second), unless `PYPARDISO_MKL_RT` names it.  We set it
+    (`setdefault`: a path the user gave is kept; child processes inherit it) to the library that
+    pip's `mkl` wheel puts in `sys.prefix/lib`, or else to the one the first construction found."""
+    import glob
+    import os
+    import sys
+
+    import pypardiso
+
+    if "PYPARDISO_MKL_RT" not in os.environ:
+        found = sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")))
+        if found:
+            os.environ["PYPARDISO_MKL_RT"] = found[0]
+    solver = pypardiso.PyPardisoSolver(mtype=mtype)
+    os.environ.setdefault("PYPARDISO_MKL_RT", solver.libmkl._name)
+    return solver
 
 
 def default_factoriser() -> str | None:
@@ -225,9 +245,7 @@ class HostFactors:
         upper-triangle CSR `structure = (indptr, indices, ...)` with `values` (read by the
         weighted matching), made; freed with it.  `iparm`: options (1-based, as MKL numbers
         them), used only with iparm(1) = 1 (else Pardiso's defaults)."""
-        import pypardiso
-
-        handle = pypardiso.PyPardisoSolver(mtype=-2)
+        handle = pardiso_solver(-2)
         handle.libmkl.MKL_Set_Num_Threads(PARDISO_THREADS)
         handle.set_iparm(12, 0)  # CSR (of the upper triangle)
         for i, value in (iparm or {}).items():

@@ -321,11 +321,10 @@ def _projector(J):
 
 @functools.cache
 def _pardiso_handle():
-    """One symmetric-indefinite Pardiso handle per process, reused (freed by `_Inertia.close`):
-    constructing one looks up MKL's runtime, ~0.15 s."""
-    import pypardiso
+    """One symmetric-indefinite Pardiso handle per process, reused (freed by `_Inertia.close`)."""
+    from ._direct import pardiso_solver
 
-    return pypardiso.PyPardisoSolver(mtype=-2)
+    return pardiso_solver(-2)
 
 
 class _Inertia:

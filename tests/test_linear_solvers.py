@@ -166,3 +166,25 @@ def test_minimize_leaves_the_saddle_that_solve_finds():
     assert np.min(np.linalg.eigvalsh(H)) > 1.0
     with pytest.raises(InvalidInputError, match="constraints"):
         minimize(elastica.clamped(8, **CLAMPED))
+
+
+@pytest.mark.skipif(not pardiso_available(), reason="MKL Pardiso not installed")
+def test_pardiso_solvers_name_the_mkl_runtime_once_found(monkeypatch, tmp_path):
+    """`pardiso_solver` leaves `PYPARDISO_MKL_RT` naming the MKL runtime the solver loaded, so
+    later constructions (and child processes) skip pypardiso's search of the file system; a
+    path the user set is kept."""
+    import os
+
+    import pypardiso
+
+    from solvers._direct import pardiso_solver
+
+    monkeypatch.delenv("PYPARDISO_MKL_RT", raising=False)
+    solver = pardiso_solver(-2)
+    path = os.environ["PYPARDISO_MKL_RT"]
+    assert os.path.isfile(path) and "mkl_rt" in os.path.basename(path)
+    assert os.path.samefile(pypardiso.PyPardisoSolver().libmkl._name, solver.libmkl._name)
+    own = tmp_path / "libmkl_rt.so"  # the user's own name of the library, kept
+    own.symlink_to(path)
+    monkeypatch.setenv("PYPARDISO_MKL_RT", str(own))
+    assert pardiso_solver(11).libmkl._name == str(own) and os.environ["PYPARDISO_MKL_RT"] == str(own)
