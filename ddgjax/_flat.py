@@ -12,6 +12,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ._host import namespace, on_device
+
 
 @dataclass(frozen=True, eq=False)
 class Layout:
@@ -40,19 +42,26 @@ class Layout:
 
     def ravel(self, x) -> jax.Array:
         """Flatten a pytree shaped like x0 into one vector (leaf by leaf, C order)."""
-        return jnp.concatenate([jnp.ravel(leaf) for leaf in jax.tree_util.tree_leaves(x)])
+        xp = namespace(x)
+        return on_device(xp.concatenate([xp.ravel(leaf) for leaf in jax.tree_util.tree_leaves(x)]))
 
     def unravel(self, z: jax.Array):
+        xp = namespace(z)
+        z = xp.asarray(z)
         leaves, start = [], 0
         for shape in self.shapes:
             size = int(np.prod(shape, dtype=int))
-            leaves.append(z[start : start + size].reshape(shape))
+            leaves.append(on_device(z[start : start + size].reshape(shape)))
             start += size
         return jax.tree_util.tree_unflatten(self.treedef, leaves)
 
     def embed(self, z0: jax.Array, u: jax.Array) -> jax.Array:
         """The full flat vector: fixed entries from `z0`, free entries from `u`."""
-        return z0.at[self.free].set(u)
+        if namespace(z0, u) is np:
+            z = np.array(z0, dtype=np.result_type(np.asarray(z0).dtype, np.asarray(u).dtype))
+            z[self.free] = np.asarray(u)
+            return on_device(z)
+        return jnp.asarray(z0).at[self.free].set(u)
 
     def x_of(self, z0: jax.Array, u: jax.Array):
         return self.unravel(self.embed(z0, u))

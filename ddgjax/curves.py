@@ -39,6 +39,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ._checks import check_positive, is_concrete
+from ._host import namespace
 from .errors import ArcLengthError, InvalidInputError, NonFiniteError, ShapeError, SingularVertexError
 from .mesh.lengths import normalised
 
@@ -595,8 +596,14 @@ def from_tangents(T: Curve, start=None, edge_length: float = 1.0) -> Curve:
     """
     T = _as_rows(T, "T", "tangent", 1)
     d = T.shape[1]
-    start = jnp.zeros(d) if start is None else jnp.asarray(start, dtype=float)
-    if start.shape != (d,):
-        raise ShapeError(f"start must have shape ({d},) like the rows of T, got {start.shape}")
+    start = np.zeros(d) if start is None else namespace(start).asarray(start, dtype=float)
+    if np.shape(start) != (d,):
+        raise ShapeError(f"start must have shape ({d},) like the rows of T, got {np.shape(start)}")
+    return _summed_steps(T, start, edge_length)
+
+
+@jax.jit
+def _summed_steps(T: Float[Array, "m d"], start: Float[Array, " d"], edge_length) -> Float[Array, "m+1 d"]:
+    """`γ_k = start + ε Σ_{j<k} T_j`, k = 0..M."""
     steps = jnp.cumsum(edge_length * T, axis=0)
-    return start + jnp.concatenate([jnp.zeros((1, d)), steps])
+    return start + jnp.concatenate([jnp.zeros((1, T.shape[1]), steps.dtype), steps])

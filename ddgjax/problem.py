@@ -28,6 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ._checks import check_finite, check_same_structure, is_concrete, leaf_paths
+from ._host import namespace, on_device
 from .errors import NotScalarError, OverconstrainedError, ShapeError
 from .locality import Local
 
@@ -117,8 +118,7 @@ def _as_float_tree(x0, name: str):
     def convert(leaf):
         if isinstance(leaf, jax.core.Tracer):
             return leaf.astype(jnp.result_type(float))
-        arr = np.array(leaf, dtype=np.float64)  # a private copy
-        return jnp.asarray(arr)
+        return jax.device_put(np.array(leaf, dtype=np.float64))  # a private copy; device_put compiles nothing
 
     return jax.tree_util.tree_map(convert, x0)
 
@@ -172,8 +172,9 @@ class ConstraintStructure:
         return isinstance(other, ConstraintStructure) and self.key() == other.key()
 
     def ravel(self, tree) -> jax.Array:
-        leaves = [jnp.ravel(leaf) for leaf in jax.tree_util.tree_leaves(tree)]
-        return jnp.concatenate(leaves) if leaves else jnp.zeros((0,))
+        xp = namespace(tree)
+        leaves = [xp.ravel(leaf) for leaf in jax.tree_util.tree_leaves(tree)]
+        return on_device(xp.concatenate(leaves) if leaves else xp.zeros((0,)))
 
     def unravel(self, flat: jax.Array):
         if not self.named:
@@ -240,7 +241,7 @@ def flatten_multipliers(problem: Problem, multipliers) -> jax.Array:
     else:
         if np.shape(multipliers) != (structure.size,):
             raise ShapeError(f"multipliers must have shape ({structure.size},), got {np.shape(multipliers)}")
-        flat = jnp.asarray(multipliers)
+        flat = on_device(namespace(multipliers).asarray(multipliers))
     if is_concrete(multipliers):
         check_finite(multipliers, "multipliers")
     return flat

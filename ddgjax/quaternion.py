@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
@@ -122,6 +123,7 @@ def check_unit(q, name: str = "q", tol: float = UNIT_TOL) -> None:
 # the algebra H (3.1)
 
 
+@jax.jit
 def _mul(p: Array, q: Array) -> Array:
     p0, pv = p[..., :1], p[..., 1:]
     q0, qv = q[..., :1], q[..., 1:]
@@ -138,6 +140,7 @@ def mul(p: Quaternion, q: Quaternion) -> Quaternion:
     return _mul(as_quaternion(p, "p"), as_quaternion(q, "q"))
 
 
+@jax.jit
 def _conj(q: Array) -> Array:
     return q * jnp.asarray([1.0, -1.0, -1.0, -1.0])
 
@@ -152,6 +155,7 @@ def norm(q: Quaternion) -> Float[Array, "..."]:
     return jnp.linalg.norm(as_quaternion(q), axis=-1)
 
 
+@jax.jit
 def _inv(q: Array) -> Array:
     return _conj(q) / jnp.sum(q * q, axis=-1, keepdims=True)
 
@@ -178,6 +182,7 @@ def to_vector(q: Quaternion) -> Vector:
 # rotations (Prop 3.6, Remark 3.5)
 
 
+@jax.jit
 def _rotate(q: Array, v: Array) -> Array:
     # q v q̄ / |q|² expanded: ((q0² − |u|²) v + 2<u, v> u + 2 q0 u × v) / |q|², u = Im q
     q0, u = q[..., :1], q[..., 1:]

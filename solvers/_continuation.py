@@ -258,7 +258,7 @@ class _Family:
         import scipy.sparse as sp
 
         z0, params, dz0, dparams, weights = self.at(float(y[-1]))
-        F, K, F_p, energy = _system(self.spec, self.linear, z0, params, jnp.asarray(y[:-1]), dz0, dparams)
+        F, K, F_p, energy = _system(self.spec, self.linear, z0, params, np.asarray(y[:-1]), dz0, dparams)
         F, K, F_p = np.asarray(F), np.asarray(K), np.asarray(F_p)
         if not isinstance(self.linear, DenseLU):
             pattern, N = self.linear.pattern, F.size
@@ -271,7 +271,7 @@ class _Family:
         spec, p = self.spec, float(y[-1])
         problem = self.problem(p)
         z0 = spec.layout.ravel(problem.x0)
-        u, lam = jnp.asarray(y[: spec.n]), jnp.asarray(y[spec.n: -1])
+        u, lam = np.asarray(y[: spec.n]), np.asarray(y[spec.n: -1])
         x = jax.tree_util.tree_map(np.asarray, spec.layout.x_of(z0, u))
         energy = float(_energy(spec, z0, problem.params, u))
         return x, jax.tree_util.tree_map(np.asarray, spec.constraint_structure.unravel(lam)), energy

@@ -15,8 +15,10 @@ from typing import Callable
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ddgjax._flat import Layout, layout_of
+from ddgjax._host import namespace, on_device
 from ddgjax.locality import Local
 from ddgjax.problem import ConstraintStructure
 
@@ -105,16 +107,19 @@ class KKT:
 def residual_weights(problem, spec: Spec):
     """`(s_E, s_g)` arrays for the scaled residual; see `Problem.residual_scale`."""
     if problem.residual_scale is None:
-        return jnp.ones((spec.n,)), jnp.ones((spec.m,))
+        return on_device(np.ones((spec.n,))), on_device(np.ones((spec.m,)))
     s_e, s_g = problem.residual_scale
-    s_e = jnp.broadcast_to(jnp.asarray(s_e, dtype=float), (spec.n,))
-    s_g = jnp.broadcast_to(jnp.asarray(s_g, dtype=float), (spec.m,))
-    return s_e, s_g
+    xp = namespace(problem.residual_scale)
+    s_e = xp.broadcast_to(xp.asarray(s_e, dtype=float), (spec.n,))
+    s_g = xp.broadcast_to(xp.asarray(s_g, dtype=float), (spec.m,))
+    return on_device(s_e), on_device(s_g)
 
 
 def scaled_residual(R, weights, n: int):
     """`max(|s_E·(∇E − Jᵀλ)|∞, |s_g·g|∞)`."""
     s_e, s_g = weights
-    scaled = jnp.concatenate([s_e * R[:n], s_g * R[n:]])
-    return jnp.max(jnp.abs(scaled)) if scaled.size else jnp.zeros(())
+    xp = namespace(R, weights)
+    R, s_e, s_g = xp.asarray(R), xp.asarray(s_e), xp.asarray(s_g)
+    scaled = xp.concatenate([s_e * R[:n], s_g * R[n:]])
+    return xp.max(xp.abs(scaled)) if scaled.size else xp.zeros(())
 

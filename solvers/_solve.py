@@ -7,8 +7,10 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ddgjax._checks import check_positive, checked_count, is_concrete
+from ddgjax._host import on_device
 from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError
 from ddgjax.problem import Problem, flatten_multipliers
 
@@ -310,7 +312,7 @@ def _label(problem: Problem) -> str:
 
 def _finish(problem: Problem, sol: Solution, throw: bool, tol: float) -> Solution:
     steps = int(sol.steps)
-    sol = sol._replace(history=sol.history[: steps + 1])
+    sol = sol._replace(history=on_device(np.asarray(sol.history)[: steps + 1]))
     status = int(sol.status)
     if status == NONFINITE and steps == 0:
         raise NonFiniteError(

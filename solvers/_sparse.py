@@ -29,7 +29,7 @@ def _analyze(rows: np.ndarray, cols: np.ndarray, size: int):
     import klujax
 
     with jax.ensure_compile_time_eval():
-        return klujax.analyze(jnp.asarray(rows), jnp.asarray(cols), size)
+        return klujax.analyze(jax.device_put(rows), jax.device_put(cols), size)
 
 
 @dataclass(frozen=True, eq=False)

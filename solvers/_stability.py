@@ -149,11 +149,11 @@ def stability(problem: Problem, solution: Solution, k: int = 6, *, method: str =
     if method == "sparse" and not spec.is_local:
         raise InvalidInputError("method='sparse' needs a problem declared local (dg.local_sum, dg.local_map)")
     u = z[spec.layout.free]
-    H, J = _hessian_and_jacobian(problem, spec, z, jnp.concatenate([u, lam]), method)
+    H, J = _hessian_and_jacobian(problem, spec, z, np.concatenate([u, lam]), method)
     scale = max(float(abs(H).sum(axis=1).max()), np.finfo(float).tiny)
     generators = _symmetry_generators(spec.layout, z)[spec.layout.free]
     eig, vec, index, zero_modes = (_dense if method == "dense" else _sparse)(H, J, generators, k, scale, tol, zero_tol)
-    modes = tuple(spec.layout.unravel(jnp.zeros(spec.layout.n_total).at[spec.layout.free].set(v)) for v in vec.T)
+    modes = tuple(spec.layout.unravel(spec.layout.embed(np.zeros(spec.layout.n_total), v)) for v in np.asarray(vec).T)
     return Stability(int(index), eig, vec, int(zero_modes), scale, modes)
 
 
@@ -173,14 +173,14 @@ def _checked_point(problem: Problem, spec, solution) -> tuple[jax.Array, jax.Arr
         lam = flatten_multipliers(problem, solution.multipliers)
     except ShapeError as error:
         raise ShapeError(f"solution.multipliers do not fit this problem's constraints: {error}") from None
-    z = spec.layout.ravel(solution.x).astype(float)
-    z0 = spec.layout.ravel(problem.x0)
+    z = np.asarray(spec.layout.ravel(solution.x), dtype=float)
+    z0 = np.asarray(spec.layout.ravel(problem.x0))
     fixed = np.setdiff1d(np.arange(spec.layout.n_total), spec.layout.free)
     moved = fixed[np.asarray(z[fixed] != z0[fixed])]
     if moved.size:
         raise InvalidInputError(
             f"solution.x differs from problem.x0 at fixed entry {int(moved[0])} (flat index): a solution of another problem?")
-    R = _residual(spec, z, problem.params, jnp.concatenate([z[spec.layout.free], lam]))
+    R = _residual(spec, z, problem.params, np.concatenate([z[spec.layout.free], np.asarray(lam)]))
     residual = float(scaled_residual(R, residual_weights(problem, spec), spec.n))
     if not residual <= CRITICAL_TOL:
         raise InvalidInputError(

@@ -32,6 +32,7 @@ LAYER_OF_PREFIX = {
     "ddgjax.errors": LANGUAGE,
     "ddgjax._checks": LANGUAGE,
     "ddgjax._flat": LANGUAGE,
+    "ddgjax._host": LANGUAGE,
     "ddgjax.curves": GEOMETRY,
     "ddgjax.quaternion": GEOMETRY,
     "ddgjax.frames": GEOMETRY,

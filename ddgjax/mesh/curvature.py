@@ -28,6 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from .._checks import check_positive, is_concrete
+from .._host import namespace
 from ..errors import MeshError, OrientationError, SingularVertexError
 from .connectivity import Halfedges, check_has_faces, checked_corners, faces_as_corners, from_faces
 from .lengths import check_positions
@@ -58,11 +59,12 @@ def _corners(F):
     if hasattr(F, "shape") and len(F.shape) == 2:
         nf, k = F.shape
         index = np.arange(nf * k).reshape(nf, k)
-        return jnp.reshape(jnp.asarray(F), -1), np.roll(index, -1, 1).reshape(-1), np.roll(index, 1, 1).reshape(-1)
+        xp = namespace(F)
+        return xp.reshape(xp.asarray(F), -1), np.roll(index, -1, 1).reshape(-1), np.roll(index, 1, 1).reshape(-1)
     vertex, _, nxt = faces_as_corners(F)
     prv = np.empty_like(nxt)
     prv[nxt] = np.arange(nxt.size)
-    return jnp.asarray(vertex), nxt, prv
+    return vertex, nxt, prv
 
 
 def _check_positions(V) -> None:

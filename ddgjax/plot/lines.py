@@ -82,6 +82,10 @@ def curves(
     return _finish(ax, path)
 
 
+CONVERGENCE_MARGINS = dict(left=0.2, right=0.96, bottom=0.14, top=0.9)
+"""The axes of `convergence` in figure fractions: room for log tick labels and one-line labels."""
+
+
 def convergence(table: ConvergenceTable, path=None, *, title: str | None = None):
     """Log-log plot of a `ddgjax.limits.ConvergenceTable`: one 2-D axes with the errors against n
     (points joined, labelled `table.label`) and a dashed reference line of slope −p through the
@@ -97,7 +101,8 @@ def convergence(table: ConvergenceTable, path=None, *, title: str | None = None)
     ax.set_ylabel(table.label)
     ax.set_title(title or f"fitted order {table.fitted_order:.2f}")
     ax.legend()
-    return fig if path is None else save_figure(fig, path)
+    fig.subplots_adjust(**CONVERGENCE_MARGINS)  # fixed: matplotlib's tight layout would draw the figure twice
+    return fig if path is None else save_figure(fig, path, tight=False)
 
 
 def spin_chain(S, ax=None, *, path=None, title: str | None = None):
