@@ -24,6 +24,7 @@ from jaxtyping import Array, Float
 
 from ._checks import check_finite, check_positive, check_same_structure, checked_count, is_concrete
 from ._flat import layout_of
+from ._host import on_device
 from .errors import ConvergenceError, InvalidInputError, ShapeError
 from .problem import Problem, constraint_values
 
@@ -241,7 +242,7 @@ def _fixed_steps(fy, y0, t1, steps, stages, cy):
         return y, y
 
     _, ys = jax.lax.scan(step, y0, None, length=steps)
-    return jnp.linspace(0.0, t1, steps + 1), jnp.concatenate([y0[None], ys])
+    return on_device(np.linspace(0.0, t1, steps + 1)), jnp.concatenate([y0[None], ys])
 
 
 def _adaptive(fy, y0, t1, rtol, saves, cy):

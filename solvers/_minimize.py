@@ -29,6 +29,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ddgjax._host import on_device
 from ddgjax.errors import ConvergenceError, InvalidInputError
 from ddgjax.problem import Problem
 
@@ -64,8 +65,14 @@ def _apply(linear: SparseDirect, token, b):
     return linear.apply(token, b)
 
 
+def _host_energy_gradient(spec, z0, params, u) -> tuple[float, np.ndarray]:
+    """`(E(u), ∇E(u))` as a float and a NumPy array."""
+    energy, grad = _energy_gradient(spec, z0, params, u)
+    return float(energy), np.asarray(grad)
+
+
 def _scale(linear, K) -> float:
-    return max(float(jnp.max(jnp.abs(K))), 1.0) if K.size else 1.0
+    return max(float(np.max(np.abs(np.asarray(K)))), 1.0) if K.size else 1.0
 
 
 def _convexified(linear, K, delta: float):
@@ -129,8 +136,8 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
     z0 = spec.layout.ravel(problem.x0)
     params = problem.params
     weights = residual_weights(problem, spec)
-    u = z0[spec.layout.free]
-    energy, grad = _energy_gradient(spec, z0, params, u)
+    u = np.asarray(z0)[spec.layout.free]  # the loop runs on the host in NumPy: no program per operation
+    energy, grad = _host_energy_gradient(spec, z0, params, u)
     history = [float(scaled_residual(grad, weights, spec.n))]
     delta, status = 0.0, "reached max_steps"
     for step in range(max_steps + 1):
@@ -146,15 +153,15 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
         if solve_with is None:
             status = "no shift makes the Hessian positive definite (non-finite entries: a degenerate configuration)"
             break
-        d = solve_with(-grad)
-        slope = float(jnp.dot(grad, d))
+        d = np.asarray(solve_with(-grad))
+        slope = float(np.dot(grad, d))
         alpha, accepted = 1.0, False
         for _ in range(MAX_BACKTRACK):
-            e_new, g_new = _energy_gradient(spec, z0, params, u + alpha * d)
+            e_new, g_new = _host_energy_gradient(spec, z0, params, u + alpha * d)
             decrease = float(energy - e_new)
             if np.isfinite(float(e_new)) and (
                 decrease >= -ARMIJO * alpha * slope
-                or (abs(decrease) <= ROUNDOFF * abs(float(energy)) and float(jnp.max(jnp.abs(g_new))) < float(jnp.max(jnp.abs(grad))))
+                or (abs(decrease) <= ROUNDOFF * abs(float(energy)) and float(np.max(np.abs(g_new))) < float(np.max(np.abs(grad))))
             ):
                 accepted = True
                 break
@@ -165,7 +172,7 @@ def minimize(problem: Problem, *, tol: float = 1e-10, max_steps: int = 200, line
         u, energy, grad = u + alpha * d, e_new, g_new
         history.append(float(scaled_residual(grad, weights, spec.n)))
     sol = solve(problem.with_x0(spec.layout.x_of(z0, u)), linear_solver=linear_solver, tol=max(tol, history[-1]), max_steps=0, throw=False)
-    sol = sol._replace(steps=jnp.asarray(len(history) - 1), history=jnp.asarray(history),
+    sol = sol._replace(steps=jnp.asarray(len(history) - 1), history=on_device(np.asarray(history)),
                        converged=jnp.asarray(status == "converged"), residual=jnp.asarray(history[-1]))
     if throw and status != "converged":
         raise ConvergenceError(

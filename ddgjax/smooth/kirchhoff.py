@@ -38,6 +38,7 @@ from jaxtyping import Array, Float
 
 from .. import quaternion as qt
 from ..curves import from_tangents
+from .._host import namespace
 from ..errors import ConvergenceError, InvalidInputError
 from ..frames import angular_velocity, edge_frame_split
 from .top import TopState, equations_of_motion
@@ -100,14 +101,21 @@ def _sample(rod: SmoothRod, s) -> tuple:
 
     **Raises:** `InvalidInputError` for concrete arc lengths that decrease somewhere (the
     integrator saves along one direction of s only)."""
-    s = jnp.asarray(s, dtype=float)
+    xp = namespace(s)
+    s = xp.asarray(s, dtype=float)
     m = s.shape[0]
-    if not isinstance(s, jax.core.Tracer) and m > 1 and bool(jnp.any(jnp.diff(s) < 0)):
-        k = int(jnp.argmax(jnp.diff(s) < 0))
+    if xp is np and m > 1 and bool(np.any(np.diff(s) < 0)):
+        k = int(np.argmax(np.diff(s) < 0))
         raise InvalidInputError(f"arc lengths must be non-decreasing: s[{k + 1}] = {float(s[k + 1])!r} < s[{k}] = "
                                 f"{float(s[k])!r}")
-    padded = jnp.concatenate([s, jnp.full((-m % SAMPLE_BUCKET,), s[-1])]) if m else s
-    ys = _integrate_jit(rod.Phi0, rod.M0, rod.a, jnp.asarray(rod.alpha), jnp.asarray(rod.length), padded)
+    padded = xp.concatenate([s, xp.full((-m % SAMPLE_BUCKET,), s[-1])]) if m else s
+    ys = _integrate_jit(rod.Phi0, rod.M0, rod.a, rod.alpha, rod.length, padded)
+    return _first_rows(ys, m)
+
+
+@partial(jax.jit, static_argnums=1)
+def _first_rows(ys: tuple, m: int) -> tuple:
+    """The first m rows of each array of `ys` (one program, not one slice per array)."""
     return tuple(y[:m] for y in ys)
 
 
