@@ -24,6 +24,7 @@ The unknown `x` of a local problem is a single array of shape (N, d) or (N,).
 from __future__ import annotations
 
 import weakref
+from functools import partial
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -32,6 +33,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Int
 
+from ._checks import is_concrete
 from .errors import InvalidInputError, ShapeError
 
 __all__ = ["Term", "Local", "local_sum", "local_map", "concat"]
@@ -183,6 +185,12 @@ class Local:
         object.__setattr__(self, "hash_value", hash(self.key()))
 
     def __call__(self, x, params=None):
+        if is_concrete((x, params)):  # called eagerly (not by a solver): one program per shape
+            return _evaluated(self, x, params)
+        return self.evaluate(x, params)
+
+    def evaluate(self, x, params=None):
+        """The groups' outputs at `x`: summed over each group's terms, joined or named."""
         x = jnp.asarray(x)
         outs = [sum(term(x, params) for term in group) for group in self.groups]
         if self.names is None:
@@ -204,6 +212,12 @@ class Local:
 
     def __eq__(self, other):
         return isinstance(other, Local) and self.key() == other.key()
+
+
+@partial(jax.jit, static_argnums=0)
+def _evaluated(local: Local, x, params):
+    """`local.evaluate(x, params)` compiled once per declaration and shape."""
+    return local.evaluate(x, params)
 
 
 def _joined(outs: list) -> Array:
