@@ -118,7 +118,7 @@ def _as_float_tree(x0, name: str):
     def convert(leaf):
         if isinstance(leaf, jax.core.Tracer):
             return leaf.astype(jnp.result_type(float))
-        return jax.device_put(np.array(leaf, dtype=np.float64))  # a private copy; device_put compiles nothing
+        return on_device(np.array(leaf, dtype=np.float64))  # a private copy
 
     return jax.tree_util.tree_map(convert, x0)
 
