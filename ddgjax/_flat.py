@@ -12,7 +12,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ._host import namespace, on_device
+from ._host import namespace, on_device, with_set
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,11 +57,7 @@ class Layout:
 
     def embed(self, z0: jax.Array, u: jax.Array) -> jax.Array:
         """The full flat vector: fixed entries from `z0`, free entries from `u`."""
-        if namespace(z0, u) is np:
-            z = np.array(z0, dtype=np.result_type(np.asarray(z0).dtype, np.asarray(u).dtype))
-            z[self.free] = np.asarray(u)
-            return on_device(z)
-        return jnp.asarray(z0).at[self.free].set(u)
+        return on_device(with_set(z0, self.free, u))
 
     def x_of(self, z0: jax.Array, u: jax.Array):
         return self.unravel(self.embed(z0, u))

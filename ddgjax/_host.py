@@ -14,7 +14,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["namespace", "on_device"]
+__all__ = ["namespace", "on_device", "with_set"]
 
 
 def namespace(*trees):
@@ -26,3 +26,13 @@ def namespace(*trees):
 def on_device(x):
     """A NumPy array as a JAX array (`jax.device_put`, no compilation); anything else as is."""
     return jax.device_put(x) if isinstance(x, (np.ndarray, np.generic)) else x
+
+
+def with_set(x, index, values):
+    """`x` with `x[index] = values`, `x` unchanged: a NumPy copy for concrete values,
+    `x.at[index].set(values)` under a trace (where the result stays differentiable in both)."""
+    if namespace(x, values) is np:
+        out = np.array(x, dtype=np.result_type(np.asarray(x).dtype, np.asarray(values).dtype))
+        out[index] = np.asarray(values)
+        return out
+    return jnp.asarray(x).at[index].set(values)

@@ -30,6 +30,7 @@ from scipy.sparse.linalg import splu
 
 import ddgjax as dg
 from ddgjax._checks import check_finite, concrete_value
+from ddgjax._host import namespace, with_set
 from ddgjax.errors import NonUniqueSolutionError, ShapeError
 from ddgjax.laplace import (
     checked_graph,
@@ -63,7 +64,7 @@ def _face_term(f3, k, params):
 def _boundary_data(n: int, boundary, values) -> tuple[np.ndarray, jax.Array]:
     """`(V₀, c)`: validated boundary indices and values (c traceable)."""
     b = boundary_indices(boundary, n)
-    c = jnp.asarray(values, dtype=float).reshape(-1)
+    c = namespace(values).asarray(values, dtype=float).reshape(-1)
     if c.shape != (b.size,):
         raise ShapeError(f"values must have shape ({b.size},), one per boundary vertex, got {np.shape(values)}")
     check_finite(c, "values")
@@ -73,8 +74,9 @@ def _boundary_data(n: int, boundary, values) -> tuple[np.ndarray, jax.Array]:
 def _start(n: int, b: np.ndarray, c: jax.Array) -> jax.Array:
     """c on V₀ (traced: the solution is differentiable in c through these fixed entries) and the
     mean of c elsewhere (no derivative: the solution's does not depend on the start)."""
-    fill = jax.lax.stop_gradient(c.mean()) if c.size else 0.0
-    return jnp.full(n, fill).at[b].set(c)
+    xp = namespace(c)
+    fill = jax.lax.stop_gradient(c.mean()) if c.size and xp is jnp else (float(np.mean(c)) if c.size else 0.0)
+    return with_set(xp.full(n, fill), b, c)
 
 
 def _problem(energy, params, L, n: int, boundary, values, name: str) -> dg.Problem:

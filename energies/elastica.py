@@ -49,6 +49,7 @@ from jaxtyping import Array, Float
 
 import ddgjax as dg
 from ddgjax._checks import check_positive, checked_count, checked_shape, concrete_value, is_concrete, when_concrete
+from ddgjax._host import namespace, with_set
 from ddgjax.errors import InvalidInputError, NonFiniteError
 
 __all__ = [
@@ -227,13 +228,13 @@ def starting_array(x0, default, shape: tuple):
     """`x0` (shape-checked) or the `default()` start, as an array `Problem` then copies."""
     X0 = default() if x0 is None else x0
     checked_shape(X0, shape, "x0")
-    return jnp.asarray(X0, dtype=float)
+    return namespace(X0).asarray(X0, dtype=float)
 
 
 def clamp_ends(X0, first, last) -> tuple[jax.Array, np.ndarray]:
     """X0 with its first and last rows set to the clamps (traceable: the derivative with
     respect to the clamps flows through these fixed entries), and the `fixed` mask of those rows."""
-    X0 = jnp.asarray(X0, dtype=float).at[0].set(first).at[-1].set(last)
+    X0 = with_set(with_set(namespace(X0).asarray(X0, dtype=float), 0, first), -1, last)
     fixed = np.zeros(X0.shape, bool)
     fixed[[0, -1]] = True
     return X0, fixed
