@@ -60,7 +60,7 @@ class Layout:
         return on_device(with_set(z0, self.free, u))
 
     def x_of(self, z0: jax.Array, u: jax.Array):
-        return self.unravel(self.embed(z0, u))
+        return self.unravel(with_set(z0, self.free, u))  # unravel puts the leaves on the device
 
 
 def layout_of(problem) -> Layout:

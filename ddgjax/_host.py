@@ -30,7 +30,7 @@ def on_device(x):
 
 def with_set(x, index, values):
     """`x` with `x[index] = values`, `x` unchanged: a NumPy copy for concrete values,
-    `x.at[index].set(values)` under a trace (where the result stays differentiable in both)."""
+    `x.at[index].set(values)` when either is traced (differentiable in `x` and `values`)."""
     if namespace(x, values) is np:
         out = np.array(x, dtype=np.result_type(np.asarray(x).dtype, np.asarray(values).dtype))
         out[index] = np.asarray(values)

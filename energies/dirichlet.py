@@ -62,7 +62,7 @@ def _face_term(f3, k, params):
 
 
 def _boundary_data(n: int, boundary, values) -> tuple[np.ndarray, jax.Array]:
-    """`(V₀, c)`: validated boundary indices and values (c traceable)."""
+    """`(V₀, c)`: validated boundary indices and values (c traceable; NumPy when concrete)."""
     b = boundary_indices(boundary, n)
     c = namespace(values).asarray(values, dtype=float).reshape(-1)
     if c.shape != (b.size,):
@@ -75,7 +75,7 @@ def _start(n: int, b: np.ndarray, c: jax.Array) -> jax.Array:
     """c on V₀ (traced: the solution is differentiable in c through these fixed entries) and the
     mean of c elsewhere (no derivative: the solution's does not depend on the start)."""
     xp = namespace(c)
-    fill = jax.lax.stop_gradient(c.mean()) if c.size and xp is jnp else (float(np.mean(c)) if c.size else 0.0)
+    fill = 0.0 if not c.size else np.mean(c) if xp is np else jax.lax.stop_gradient(c.mean())
     return with_set(xp.full(n, fill), b, c)
 
 

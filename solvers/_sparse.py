@@ -16,6 +16,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ddgjax._host import on_device
 from ddgjax.errors import InvalidInputError
 from ddgjax.locality import Local, Term
 
@@ -29,7 +30,7 @@ def _analyze(rows: np.ndarray, cols: np.ndarray, size: int):
     import klujax
 
     with jax.ensure_compile_time_eval():
-        return klujax.analyze(jax.device_put(rows), jax.device_put(cols), size)
+        return klujax.analyze(on_device(rows), on_device(cols), size)
 
 
 @dataclass(frozen=True, eq=False)
