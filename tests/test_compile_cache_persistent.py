@@ -6,6 +6,10 @@ is therefore an argument of the solver, not a constant (`solvers/_klu.py`).  The
 bakes a process-dependent constant into a program and sees it miss.  Programs with host callbacks
 (the `SparseDirect` factorisations) are never cached: they neither hit nor miss, they compile
 (`compiles` counts XLA's compilations).
+
+The cases run as the sections of one probe, in a first and a second process on the same empty
+cache folder (two interpreters for all cases, not two per case); each section's events are
+counted apart.  Sections compile disjoint programs, and run in the same order in both processes.
 """
 
 import json
@@ -17,6 +21,29 @@ from pathlib import Path
 import pytest
 
 from ddgjax import compile_cache
+
+SECTIONS = {
+    "solve": """
+from energies import elastica
+from solvers import solve, KLU
+solve(elastica.clamped(12, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0)), linear_solver=KLU())
+""",
+    "process_dependent": """
+import os, jax, jax.numpy as jnp
+jax.jit(lambda x: x + os.getpid())(jnp.zeros(3)).block_until_ready()
+""",
+    "no_steps": """
+import ddgjax as dg
+from energies import area
+from solvers import solve, SparseDirect
+V, F = dg.mesh.disk(1, 6)
+solve(area.simplicial(V + [0, 0, 0.1] * (V[:, :1] > 0), F), linear_solver=SparseDirect(), max_steps=0, throw=False)
+""",
+    "host_callback": """
+import jax, jax.numpy as jnp, numpy as np
+jax.jit(lambda x: jax.pure_callback(np.sin, x, x))(jnp.zeros(4)).block_until_ready()
+""",
+}
 
 PROBE = """
 import json, sys
@@ -30,42 +57,54 @@ def counted(*args, **kwargs):
 compiler.backend_compile_and_load = counted
 from ddgjax import compile_cache
 compile_cache.enable(sys.argv[1])
-{code}
-print(json.dumps({{"hits": events.count("/jax/compilation_cache/cache_hits"),
-                   "misses": events.count("/jax/compilation_cache/cache_misses"),
-                   "compiles": events.count("compile")}}))
-"""
-
-SOLVE = """
-from energies import elastica
-from solvers import solve, KLU
-solve(elastica.clamped(12, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0)), linear_solver=KLU())
-"""
-
-PROCESS_DEPENDENT = """
-import os, jax, jax.numpy as jnp
-jax.jit(lambda x: x + os.getpid())(jnp.zeros(3)).block_until_ready()
+counts = {}
+for name, code in json.loads(sys.argv[2]).items():
+    del events[:]
+    exec(code, {})
+    counts[name] = {"hits": events.count("/jax/compilation_cache/cache_hits"),
+                    "misses": events.count("/jax/compilation_cache/cache_misses"),
+                    "compiles": events.count("compile")}
+print(json.dumps(counts))
 """
 
 
-def cache_events(code: str, cache: Path) -> dict:
-    out = subprocess.run([sys.executable, "-c", PROBE.format(code=code), str(cache)], capture_output=True, text=True,
-                         timeout=300, env={k: v for k, v in os.environ.items() if k != compile_cache.ENV})
+def cache_events(cache: Path) -> dict:
+    """`{section: {"hits", "misses", "compiles"}}` of one process running every section."""
+    out = subprocess.run([sys.executable, "-c", PROBE, str(cache), json.dumps(SECTIONS)], capture_output=True,
+                         text=True, timeout=300, env={k: v for k, v in os.environ.items() if k != compile_cache.ENV})
     assert out.returncode == 0, out.stderr[-2000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def test_a_second_process_loads_every_compiled_program_of_a_solve(tmp_path):
-    first = cache_events(SOLVE, tmp_path)
-    second = cache_events(SOLVE, tmp_path)
+@pytest.fixture(scope="module")
+def processes(tmp_path_factory) -> tuple[dict, dict]:
+    """The events of a first and a second process on the same (initially empty) cache folder."""
+    cache = tmp_path_factory.mktemp("jax-cache")
+    return cache_events(cache), cache_events(cache)
+
+
+def test_a_second_process_loads_every_compiled_program_of_a_solve(processes):
+    first, second = (p["solve"] for p in processes)
     assert first["misses"] > 0
     assert second == {"hits": first["misses"] + first["hits"], "misses": 0, "compiles": 0}
 
 
-def test_a_process_dependent_constant_misses(tmp_path):
+def test_a_process_dependent_constant_misses(processes):
     """Negative control: the probe sees misses when the program differs between processes."""
-    cache_events(PROCESS_DEPENDENT, tmp_path)
-    assert cache_events(PROCESS_DEPENDENT, tmp_path)["misses"] >= 1
+    assert processes[1]["process_dependent"]["misses"] >= 1
+
+
+def test_a_solve_without_steps_has_no_host_callback_and_is_loaded_from_the_cache(processes):
+    """`max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
+    factorisation, so no host callback, which JAX never caches: a second process loads it all."""
+    first, second = (p["no_steps"] for p in processes)
+    assert first["misses"] > 0 and second["compiles"] == 0
+
+
+def test_a_program_with_a_host_callback_compiles_in_every_process(processes):
+    """Control (what a `SparseDirect` factorisation is): neither a hit nor a miss, a compilation."""
+    second = processes[1]["host_callback"]
+    assert second["misses"] == 0 and second["compiles"] == 1
 
 
 @pytest.mark.parametrize("value", ["off", "0", "False", " no "])
@@ -85,35 +124,6 @@ def test_an_unwritable_folder_leaves_the_cache_off(tmp_path):
     assert compile_cache.enable(blocker / "cache") is None
 
 
-
-NO_STEPS = """
-import ddgjax as dg
-from energies import area
-from solvers import solve, SparseDirect
-V, F = dg.mesh.disk(1, 6)
-solve(area.simplicial(V + [0, 0, 0.1] * (V[:, :1] > 0), F), linear_solver=SparseDirect(), max_steps=0, throw=False)
-"""
-
-HOST_CALLBACK = """
-import jax, jax.numpy as jnp, numpy as np
-jax.jit(lambda x: jax.pure_callback(np.sin, x, x))(jnp.zeros(3)).block_until_ready()
-"""
-
-
-def test_a_solve_without_steps_has_no_host_callback_and_is_loaded_from_the_cache(tmp_path):
-    """`max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
-    factorisation, so no host callback, which JAX never caches: a second process loads it all."""
-    cache_events(NO_STEPS, tmp_path)
-    assert cache_events(NO_STEPS, tmp_path)["compiles"] == 0
-
-
-def test_a_program_with_a_host_callback_compiles_in_every_process(tmp_path):
-    """Control (what a `SparseDirect` factorisation is): neither a hit nor a miss, a compilation."""
-    cache_events(HOST_CALLBACK, tmp_path)
-    second = cache_events(HOST_CALLBACK, tmp_path)
-    assert second["misses"] == 0 and second["compiles"] == 1
-
-
 @pytest.mark.parametrize("version, emitters_flag", [("0.10.2", True), ("0.10.0rc1", True), ("0.9.9", False),
                                                     ("0.11.0", False), ("1.0", False)])
 def test_fast_compile_flags_pass_the_emitter_flag_only_to_jaxlibs_known_to_accept_it(version, emitters_flag):
@@ -121,4 +131,3 @@ def test_fast_compile_flags_pass_the_emitter_flag_only_to_jaxlibs_known_to_accep
     flags = compile_cache.fast_compile_xla_flags(version).split()
     assert "--xla_backend_optimization_level=0" in flags
     assert ("--xla_cpu_use_fusion_emitters=false" in flags) is emitters_flag
-

@@ -104,11 +104,18 @@ def _run_two_processes(tmp_path, local_devices: int, size: int) -> list:
     return [np.load(out) for out in outs]
 
 
-@pytest.mark.parametrize(("local_devices", "size"), [(1, 4), (2, 5)])
+@pytest.mark.parametrize(("local_devices", "size"), [
+    pytest.param(1, 4, marks=pytest.mark.slow),  # one device per process: also the sweep test's case below
+    (2, 5),
+])
 def test_two_process_solve_batch_equals_single_process(tmp_path, local_devices, size):
     """2 processes × `local_devices` CPU devices, the same batch of `size` clamped elastica in
     each (5 over 4 devices: padded to 8): both get every member, equal to a single-process solve
-    to 1e-12 (the same compiled member solver on the same data: only the split differs)."""
+    to 1e-12 (the same compiled member solver on the same data: only the split differs).
+
+    One device per process is also what `ddgjax sweep --processes 2` runs (the last test), whose
+    every stored member is compared with the one-process result to 1e-12: `make test` runs that
+    case there, `make test-all` here as well."""
     results = _run_two_processes(tmp_path, local_devices, size)
     reference = solve_batch(problem(), {"chord": chords(size)})
     paths, _ = zip(*jax.tree_util.tree_flatten_with_path(reference)[0])
