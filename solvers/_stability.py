@@ -153,7 +153,7 @@ def stability(problem: Problem, solution: Solution, k: int = 6, *, method: str =
     scale = max(float(abs(H).sum(axis=1).max()), np.finfo(float).tiny)
     generators = _symmetry_generators(spec.layout, z)[spec.layout.free]
     eig, vec, index, zero_modes = (_dense if method == "dense" else _sparse)(H, J, generators, k, scale, tol, zero_tol)
-    modes = tuple(spec.layout.unravel(spec.layout.embed(np.zeros(spec.layout.n_total), v)) for v in np.asarray(vec).T)
+    modes = tuple(spec.layout.x_of(np.zeros(spec.layout.n_total), v) for v in np.asarray(vec).T)
     return Stability(int(index), eig, vec, int(zero_modes), scale, modes)
 
 
