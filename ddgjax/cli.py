@@ -17,7 +17,8 @@ that cannot be written) is printed as one line `ddgjax: error: … (hint: …)`,
 unless `--debug`.
 
 `solve`, `sweep` and `verify` keep XLA's compiled programs on disk (`ddgjax.compile_cache`): a second
-cold run loads them instead of compiling.  `DDGJAX_COMPILE_CACHE=DIR` moves the cache,
+cold run loads them instead of compiling, and calls the exported solvers instead of tracing
+them (`solvers/_exported.py`).  `DDGJAX_COMPILE_CACHE=DIR` moves the cache,
 `DDGJAX_COMPILE_CACHE=off` switches it off.
 """
 

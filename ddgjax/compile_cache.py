@@ -4,8 +4,10 @@ A cold process still traces each solver, but loads the compiled program from dis
 running XLA again.  The folder is `$DDGJAX_COMPILE_CACHE` when that is a path, otherwise
 `ddgjax/jax` in the user's cache directory (`$XDG_CACHE_HOME`, else `~/.cache`);
 `DDGJAX_COMPILE_CACHE=off` (or `0`, `false`, `no`) switches it off.  Library users opt in with
-`enable()` (a library does not write to the user's disk unasked).  The folder is not bounded
-(JAX's default): delete it to reclaim the space.
+`enable()` (a library does not write to the user's disk unasked).  `enable()` also switches on
+the exported solvers (`solvers/_exported.py`: a later process calls the solver without tracing
+it) in the folder beside, `<folder>-solvers`, unless `DDGJAX_SOLVER_CACHE=off`.  The folders are not bounded (JAX's default):
+delete them to reclaim the space.
 
 JAX keys each entry by the lowered program, the compile options and the jaxlib version, so a
 hit is the same program; the keys are stable across processes only while the traced programs
@@ -89,4 +91,8 @@ def enable(path: str | os.PathLike | None = None) -> Path | None:
     for name, value in settings.items():
         jax.config.update(name, value)
         os.environ[name.upper()] = str(value)  # spawned workers (`verify --jobs`) read these
+    from solvers._exported import FOLDER_ENV
+
+    if os.environ.get(FOLDER_ENV, "").strip().lower() not in OFF:
+        os.environ[FOLDER_ENV] = str(folder.with_name(f"{folder.name}-solvers"))
     return folder

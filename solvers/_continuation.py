@@ -56,7 +56,6 @@ eigenvector (`Bifurcation.mode`), the direction of the other branch.
 
 from __future__ import annotations
 
-from functools import partial
 from typing import Callable, NamedTuple
 
 import jax
@@ -67,6 +66,7 @@ from ddgjax.errors import ConvergenceError, InvalidInputError
 from ddgjax.problem import Problem, flatten_multipliers
 
 from ._dense import DenseLU
+from ._exported import programs
 from ._kkt import KKT, residual_weights, scaled_residual, spec_of
 from ._solve import Solution, linear_solver_of, solve
 from ._stability import stability
@@ -188,7 +188,7 @@ def _tangent_leaf(primal, tangent):
     return np.zeros(np.shape(primal), dtype=jax.dtypes.float0)
 
 
-@partial(jax.jit, static_argnums=0)
+@programs
 def _system(spec, linear, z0, params, w, dz0, dparams):
     """`(F, F_w, F_p, E)` at (w, p): the KKT residual, the KKT matrix (dense, or the values of the
     sparse pattern of `linear`), ∂F/∂p and the energy."""
@@ -199,7 +199,7 @@ def _system(spec, linear, z0, params, w, dz0, dparams):
     return F, linear.matrix(kkt, w), F_p, kkt.energy(w[: spec.n])
 
 
-@partial(jax.jit, static_argnums=0)
+@programs
 def _energy(spec, z0, params, u):
     return KKT(spec, z0, params).energy(u)
 

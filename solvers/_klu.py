@@ -80,12 +80,17 @@ def _klu_free(numeric, after) -> None:
     every solve with the factors, so its operand is made to depend on all of `after`
     (`_depending_on`).  Under `vmap` a batch of factors is freed by one call, and factors
     shared by the batch (a matrix that does not depend on the batched values) once."""
+    _register_free_numeric()
+    _free_after(numeric, after)
+
+
+def _register_free_numeric() -> None:
+    """Register `FREE_NUMERIC` (klujax's `free_numeric` handler) once per process."""
     import klujax_cpp
 
     if FREE_NUMERIC not in _REGISTERED:
         jax.ffi.register_ffi_target(FREE_NUMERIC, klujax_cpp.free_numeric(), platform="cpu")
         _REGISTERED.add(FREE_NUMERIC)
-    _free_after(numeric, after)
 
 
 @jax.custom_batching.custom_vmap
@@ -235,3 +240,14 @@ class KLU(AssembledSparse):
         one complex KLU solve on K's own pattern and analysis, with smallest singular value ≥ √ν."""
         shifted = K.astype(jnp.complex128).at[self.index["diagonal"]].add(1j * jnp.sqrt(nu))
         return -jnp.real(self.apply(shifted, R.astype(jnp.complex128)))
+
+
+def ffi_targets() -> tuple[str, ...]:
+    """The custom-call targets a program with KLU solves may call, registered in this process:
+    klujax's (under the names of `klujax_cpp`'s handlers) and `FREE_NUMERIC`."""
+    import klujax  # noqa: F401  (registers its targets)
+    import klujax_cpp
+
+    _register_free_numeric()
+    handlers = [name for name in dir(klujax_cpp) if not name.startswith("_") and name[0].islower()]
+    return (*handlers, FREE_NUMERIC)

@@ -23,7 +23,6 @@ whose derivatives with respect to the parameters are exact (implicit function th
 
 from __future__ import annotations
 
-from functools import partial
 
 import jax
 import jax.numpy as jnp
@@ -35,6 +34,7 @@ from ddgjax.problem import Problem
 
 from ._dense import DenseLU
 from ._direct import SparseDirect, default_factoriser
+from ._exported import programs
 from ._kkt import KKT, residual_weights, scaled_residual, spec_of
 from ._solve import Solution, linear_solver_of, solve
 
@@ -45,12 +45,12 @@ ROUNDOFF = 1e-14
 FLAT = 1e-10  # eigenvalues of H above −FLAT·max|H| count as zero (symmetries, flat directions)
 
 
-@partial(jax.jit, static_argnames=("spec",))
+@programs
 def _energy_gradient(spec, z0, params, u):
     return jax.value_and_grad(KKT(spec, z0, params).energy)(u)
 
 
-@partial(jax.jit, static_argnames=("spec",))
+@programs
 def _hessian(spec, linear, z0, params, u):
     return linear.matrix(KKT(spec, z0, params), u)
 

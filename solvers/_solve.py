@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from functools import partial
 from typing import NamedTuple
 
 import jax
@@ -14,13 +13,14 @@ from ddgjax._host import on_device
 from ddgjax.errors import ConvergenceError, InvalidInputError, NonFiniteError
 from ddgjax.problem import Problem, flatten_multipliers
 
-from ._first_order import augmented_lagrangian
-from ._implicit import implicit_solution
-from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
 from ._banded import chain_structure
 from ._cache import LRU, cleared_by_jax, derived
 from ._dense import DenseLU
 from ._direct import SparseDirect, default_factoriser
+from ._exported import Program
+from ._first_order import augmented_lagrangian
+from ._implicit import implicit_solution
+from ._kkt import KKT, Spec, residual_weights, scaled_residual, spec_of
 from ._klu import KLU
 from ._krylov import Krylov
 from ._linear import LinearSolver
@@ -150,10 +150,12 @@ JITTED = cleared_by_jax(LRU(COMPILED_SOLVERS), "solvers.solve compiled solvers")
 
 
 def _solve_jit(spec, linear, z0, params, lam0, weights, *, tol, max_steps, first_order, newton_phase):
-    """`_solve_impl` compiled once per (declaration, options), through the bounded `JITTED`."""
+    """`_solve_impl` compiled once per (declaration, options), through the bounded `JITTED` (and
+    across processes through the exported programs, `_exported.Program`)."""
     static = dict(tol=tol, max_steps=max_steps, first_order=first_order, newton_phase=newton_phase)
-    jitted = JITTED.get((spec, tuple(static.items())), lambda: jax.jit(partial(_solve_impl, spec, **static)))
-    return jitted(linear, z0, params, lam0, weights)
+    program = JITTED.get((spec, tuple(static.items())),
+                         lambda: Program(_solve_impl, spec, static))
+    return program(linear, z0, params, lam0, weights)
 
 
 def compiled_solver_count() -> int:

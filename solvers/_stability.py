@@ -61,7 +61,6 @@ from __future__ import annotations
 
 import functools
 
-from functools import partial
 from typing import NamedTuple
 
 import jax
@@ -74,6 +73,7 @@ from ddgjax.errors import InvalidInputError, ShapeError
 from ddgjax.problem import Problem, flatten_multipliers
 
 from ._dense import DenseLU
+from ._exported import programs
 from ._kkt import KKT, residual_weights, scaled_residual, spec_of
 from ._solve import DENSE_MAX, Solution, linear_solver_of
 
@@ -189,12 +189,12 @@ def _checked_point(problem: Problem, spec, solution) -> tuple[jax.Array, jax.Arr
     return z, lam
 
 
-@partial(jax.jit, static_argnames=("kkt_spec",))
+@programs
 def _residual(kkt_spec, z, params, w):
     return KKT(kkt_spec, z, params).residual(w)
 
 
-@partial(jax.jit, static_argnames=("kkt_spec",))
+@programs
 def _kkt_matrix(kkt_spec, linear, z, params, w):
     return linear.matrix(KKT(kkt_spec, z, params), w)
 

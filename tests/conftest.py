@@ -27,6 +27,21 @@ def tree_max_abs_diff(a, b) -> float:
     return max(jax.tree_util.tree_leaves(diffs))
 
 
+def lowered(fn):
+    """`(fn(), names)`: the names of the XLA programs lowered while `fn` runs."""
+    names = []
+
+    def listener(event, duration, **kw):
+        if event == "/jax/core/compile/jaxpr_to_mlir_module_duration":
+            names.append(kw.get("fun_name"))
+
+    jax.monitoring.register_event_duration_secs_listener(listener)
+    try:
+        return fn(), names
+    finally:
+        jax.monitoring.unregister_event_duration_listener(listener)
+
+
 @pytest.fixture(autouse=True, scope="module")
 def _release_compiled_programs():
     """Drop JAX's compiled programs after each test module.

@@ -7,6 +7,9 @@ bakes a process-dependent constant into a program and sees it miss.  Programs wi
 (the `SparseDirect` factorisations) are never cached: they neither hit nor miss, they compile
 (`compiles` counts XLA's compilations).
 
+The solver itself is exported by the first process (`solvers/_exported.py`), into the folder
+beside the cache's, and called by the second without being traced again.
+
 The cases run as the sections of one probe, in a first and a second process on the same empty
 cache folder (two interpreters for all cases, not two per case); each section's events are
 counted apart.  Sections compile disjoint programs, and run in the same order in both processes.
@@ -26,7 +29,7 @@ SECTIONS = {
     "solve": """
 from energies import elastica
 from solvers import solve, KLU
-solve(elastica.clamped(12, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0)), linear_solver=KLU())
+result = solve(elastica.clamped(12, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0)), linear_solver=KLU())
 """,
     "process_dependent": """
 import os, jax, jax.numpy as jnp
@@ -46,10 +49,14 @@ jax.jit(lambda x: jax.pure_callback(np.sin, x, x))(jnp.zeros(4)).block_until_rea
 }
 
 PROBE = """
-import json, sys
+import hashlib, json, sys
+import numpy as np
+import jax
 from jax._src import compiler, monitoring
-events = []
+events, lowered = [], []
 monitoring.register_event_listener(lambda event, **kw: events.append(event))
+monitoring.register_event_duration_secs_listener(
+    lambda event, duration, **kw: lowered.append(kw.get("fun_name")) if event.endswith("jaxpr_to_mlir_module_duration") else None)
 _compile = compiler.backend_compile_and_load
 def counted(*args, **kwargs):
     events.append("compile")
@@ -59,11 +66,14 @@ from ddgjax import compile_cache
 compile_cache.enable(sys.argv[1])
 counts = {}
 for name, code in json.loads(sys.argv[2]).items():
-    del events[:]
-    exec(code, {})
+    del events[:], lowered[:]
+    scope = {}
+    exec(code, scope)
+    leaves = [np.asarray(leaf) for leaf in jax.tree_util.tree_leaves(scope.get("result"))]
     counts[name] = {"hits": events.count("/jax/compilation_cache/cache_hits"),
                     "misses": events.count("/jax/compilation_cache/cache_misses"),
-                    "compiles": events.count("compile")}
+                    "compiles": events.count("compile"), "lowered": sorted(lowered),
+                    "result": hashlib.sha256(b"".join(leaf.tobytes() for leaf in leaves)).hexdigest()}
 print(json.dumps(counts))
 """
 
@@ -86,7 +96,17 @@ def processes(tmp_path_factory) -> tuple[dict, dict]:
 def test_a_second_process_loads_every_compiled_program_of_a_solve(processes):
     first, second = (p["solve"] for p in processes)
     assert first["misses"] > 0
-    assert second == {"hits": first["misses"] + first["hits"], "misses": 0, "compiles": 0}
+    assert {k: second[k] for k in ("hits", "misses", "compiles")} == {"hits": first["misses"] + first["hits"],
+                                                                       "misses": 0, "compiles": 0}
+
+
+def test_a_second_process_calls_the_exported_solver_without_tracing_it(processes):
+    """`solvers/_exported.py`: the first process traces and lowers the solver once (its export),
+    the second lowers only the call of the exported program, and the solutions agree bit for bit."""
+    first, second = (p["solve"] for p in processes)
+    assert "jit(_solve_impl)" in first["lowered"] and "jit(call)" in first["lowered"]
+    assert "jit(_solve_impl)" not in second["lowered"] and "jit(call)" in second["lowered"]
+    assert second["result"] == first["result"]
 
 
 def test_a_process_dependent_constant_misses(processes):
@@ -131,3 +151,18 @@ def test_fast_compile_flags_pass_the_emitter_flag_only_to_jaxlibs_known_to_accep
     flags = compile_cache.fast_compile_xla_flags(version).split()
     assert "--xla_backend_optimization_level=0" in flags
     assert ("--xla_cpu_use_fusion_emitters=false" in flags) is emitters_flag
+
+
+def test_enable_puts_the_exported_solvers_beside_the_cache_unless_they_are_switched_off(tmp_path, monkeypatch):
+    import jax
+    from solvers._exported import FOLDER_ENV, solver_dir
+
+    monkeypatch.setattr(jax.config, "update", lambda *args: None)  # this process keeps its cache
+    for name in ("JAX_COMPILATION_CACHE_DIR", "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS",
+                 "JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES", FOLDER_ENV):
+        monkeypatch.setenv(name, os.environ.get(name, ""))
+    compile_cache.enable(tmp_path / "c")
+    assert solver_dir() == tmp_path / "c-solvers"
+    monkeypatch.setenv(FOLDER_ENV, "off")
+    compile_cache.enable(tmp_path / "c")
+    assert solver_dir() is None
