@@ -23,9 +23,10 @@ The file's name is the SHA-256 of everything the solver's trace reads (`program_
   the backend and JAX's tracing flags.
 An input the key cannot describe by value (a Python function, an unknown type) sends the solve
 down the ordinary path (`NotDescribed`): a key that missed an input would return a stale
-program, i.e. a wrong answer.  Only concrete calls on one device are exported, and of the
-linear solvers only `DenseLU` and `KLU` (under `jit`, `vmap` or `grad` the solver is traced as usual, which keeps its implicit
-derivatives; `SparseDirect`'s host callbacks cannot be serialised).
+program, i.e. a wrong answer.  Only concrete calls on one device are exported (under `jit`,
+`vmap` or `grad` the solver is traced as usual, which keeps its implicit derivatives), and only
+programs without host callbacks (`SparseDirect`'s factorisations cannot be serialised; its
+programs that only assemble the KKT matrix can).
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from ddgjax.locality import Local, Term
 
 from ._cache import LRU, cleared_by_jax
 from ._dense import DenseLU
+from ._direct import SparseDirect
 from ._kkt import Spec
 from ._klu import KLU, ffi_targets
 from ._linear import LinearSolver
@@ -59,9 +61,13 @@ compilation cache unless it is `off`); unset or `off`, nothing is exported."""
 FORMAT = b"ddgjax exported solver 1\n"
 """The first bytes of every file, and of every key: a new format never reads an old file."""
 
-EXPORTABLE = (DenseLU, KLU)
-"""The linear solvers whose programs are exported: custom calls known (`ffi_targets`), no host
-callbacks, a static part described by value."""
+EXPORTABLE = (DenseLU, KLU, SparseDirect)
+"""The linear solvers whose static part the key describes by value.  A program with a host
+callback (`SparseDirect`'s factorisations) cannot be exported: the first process records that
+in the program's file (`NOT_EXPORTABLE`), and later ones trace it as usual at once."""
+
+NOT_EXPORTABLE = b"not exportable\n"
+"""The content of a program's file, after `FORMAT`, when the program could not be exported."""
 
 TRACED_LIBRARIES = ("jax", "jaxlib", "numpy", "klujax", "equinox", "lineax", "optimistix", "jaxopt")
 """Distributions whose code runs while the solver is traced (their versions are in the key)."""
@@ -289,11 +295,13 @@ def _exported(impl: functools.partial, treedef, leaves: list, targets: tuple[str
     return exported, out_tree[0]
 
 
-def _store(path: Path, exported, out_tree) -> None:
-    """Write atomically (a partly written file is never read): another process may be reading."""
+def _store(path: Path, exported=None, out_tree=None) -> None:
+    """Write the program (`NOT_EXPORTABLE` without one) atomically (a partly written file is
+    never read): another process may be reading."""
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
     try:
-        data = FORMAT + pickle.dumps((bytes(exported.serialize()), out_tree))
+        body = NOT_EXPORTABLE if exported is None else pickle.dumps((bytes(exported.serialize()), out_tree))
+        data = FORMAT + body
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp.write_bytes(data)
         os.replace(tmp, path)
@@ -302,13 +310,15 @@ def _store(path: Path, exported, out_tree) -> None:
 
 
 def _load(path: Path):
-    """`(exported, out_tree)` from `path`, or None if it is absent or unreadable."""
+    """`(exported, out_tree)` from `path`, `NOT_EXPORTABLE`, or None if it is absent or unreadable."""
     try:
         data = path.read_bytes()
     except OSError:
         return None
     if not data.startswith(FORMAT):
         return None
+    if data[len(FORMAT):] == NOT_EXPORTABLE:
+        return NOT_EXPORTABLE
     try:
         serialized, out_tree = pickle.loads(data[len(FORMAT):])
         return jax.export.deserialize(bytearray(serialized)), out_tree
@@ -371,9 +381,12 @@ class Program:
         if loaded is None:
             try:
                 loaded = _exported(self.impl, treedef, leaves, targets)
-            except Exception:  # e.g. an argument jax.export does not take (float0): the ordinary path
+            except Exception:  # a host callback, an argument jax.export does not take (float0)
+                _store(path)
                 return None
             _store(path, *loaded)
+        if loaded is NOT_EXPORTABLE:
+            return None
         exported, out_tree = loaded
         run = jax.jit(exported.call)
         return lambda flat: jax.tree_util.tree_unflatten(out_tree, run(*flat))

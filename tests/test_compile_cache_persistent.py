@@ -93,38 +93,29 @@ def processes(tmp_path_factory) -> tuple[dict, dict]:
     return cache_events(cache), cache_events(cache)
 
 
-def test_a_second_process_loads_every_compiled_program_of_a_solve(processes):
-    first, second = (p["solve"] for p in processes)
-    assert first["misses"] > 0
-    assert {k: second[k] for k in ("hits", "misses", "compiles")} == {"hits": first["misses"] + first["hits"],
-                                                                       "misses": 0, "compiles": 0}
-
-
-def test_a_second_process_calls_the_exported_solver_without_tracing_it(processes):
-    """`solvers/_exported.py`: the first process traces and lowers the solver once (its export),
-    the second lowers only the call of the exported program, and the solutions agree bit for bit."""
-    first, second = (p["solve"] for p in processes)
-    assert "jit(_solve_impl)" in first["lowered"] and "jit(call)" in first["lowered"]
-    assert "jit(_solve_impl)" not in second["lowered"] and "jit(call)" in second["lowered"]
-    assert second["result"] == first["result"]
-
-
-def test_a_process_dependent_constant_misses(processes):
-    """Negative control: the probe sees misses when the program differs between processes."""
-    assert processes[1]["process_dependent"]["misses"] >= 1
-
-
-def test_a_solve_without_steps_has_no_host_callback_and_is_loaded_from_the_cache(processes):
-    """`max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
-    factorisation, so no host callback, which JAX never caches: a second process loads it all."""
-    first, second = (p["no_steps"] for p in processes)
-    assert first["misses"] > 0 and second["compiles"] == 0
-
-
-def test_a_program_with_a_host_callback_compiles_in_every_process(processes):
-    """Control (what a `SparseDirect` factorisation is): neither a hit nor a miss, a compilation."""
-    second = processes[1]["host_callback"]
-    assert second["misses"] == 0 and second["compiles"] == 1
+def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
+    """One test for the sections of the two processes (pytest-xdist would otherwise run the
+    module fixture, two interpreters, once per worker that takes a part of the module):
+    - a solve: the second process loads every compiled program, misses none, compiles none;
+    - the solver itself (`solvers/_exported.py`): the first process traces and lowers it once
+      (its export), the second lowers only the call of the exported program, and the
+      solutions agree bit for bit;
+    - negative control: a program with a process-dependent constant misses;
+    - `max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
+      factorisation, so no host callback, which JAX never caches: the second process loads it;
+    - control (what a `SparseDirect` factorisation is): a host callback is neither a hit nor a
+      miss but a compilation, in every process."""
+    first, second = processes
+    solve_1, solve_2 = first["solve"], second["solve"]
+    assert solve_1["misses"] > 0
+    assert {k: solve_2[k] for k in ("hits", "misses", "compiles")} == {
+        "hits": solve_1["misses"] + solve_1["hits"], "misses": 0, "compiles": 0}
+    assert "jit(_solve_impl)" in solve_1["lowered"] and "jit(call)" in solve_1["lowered"]
+    assert "jit(_solve_impl)" not in solve_2["lowered"] and "jit(call)" in solve_2["lowered"]
+    assert solve_2["result"] == solve_1["result"]
+    assert second["process_dependent"]["misses"] >= 1
+    assert first["no_steps"]["misses"] > 0 and second["no_steps"]["compiles"] == 0
+    assert second["host_callback"]["misses"] == 0 and second["host_callback"]["compiles"] == 1
 
 
 @pytest.mark.parametrize("value", ["off", "0", "False", " no "])

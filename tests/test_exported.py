@@ -164,3 +164,25 @@ def test_traced_calls_and_debugging_flags_are_not_exported(folder):
     assert list(folder.glob("*")) == []
     solve(quadratic())  # control: the same solve outside them is exported
     assert len(list(folder.glob("*.program"))) == 1
+
+
+def test_a_program_with_a_host_callback_is_recorded_and_not_exported_again(folder):
+    """`SparseDirect`'s factorisations are host callbacks: the first process tries the export
+    once (and traces the program as usual), later ones trace it at once; its solve without steps
+    has no factorisation and is exported."""
+    from energies import area
+    from solvers import SparseDirect
+
+    def problem():
+        V, F = dg.mesh.disk(1, 6)
+        return area.simplicial(V + [0, 0, 0.1] * (V[:, :1] > 0), F)
+
+    _, first = lowered(lambda: solve(problem(), linear_solver=SparseDirect()))
+    assert first.count("jit(_solve_impl)") == 2  # the export tried, then the program traced
+    (path,) = folder.glob("*.program")
+    assert path.read_bytes() == _exported.FORMAT + _exported.NOT_EXPORTABLE
+    jax.clear_caches()
+    sol, second = lowered(lambda: solve(problem(), linear_solver=SparseDirect()))
+    assert second.count("jit(_solve_impl)") == 1 and sol.residual <= 1e-10
+    solve(problem(), linear_solver=SparseDirect(), max_steps=0, throw=False, warm_start=None)
+    assert len([p for p in folder.glob("*.program") if _exported._load(p) is not _exported.NOT_EXPORTABLE]) == 1
