@@ -6,8 +6,8 @@ running XLA again.  The folder is `$DDGJAX_COMPILE_CACHE` when that is a path, o
 `DDGJAX_COMPILE_CACHE=off` (or `0`, `false`, `no`) switches it off.  Library users opt in with
 `enable()` (a library does not write to the user's disk unasked).  `enable()` also switches on
 the exported solvers (`solvers/_exported.py`: a later process calls the solver without tracing
-it) in the folder beside, `<folder>-solvers`, unless `DDGJAX_SOLVER_CACHE=off`.  The folders are not bounded (JAX's default):
-delete them to reclaim the space.
+it) in the folder beside, `<folder>-solvers`, unless `DDGJAX_SOLVER_CACHE=off`.  The folders
+are not bounded (JAX's default): delete them to reclaim the space.
 
 JAX keys each entry by the lowered program, the compile options and the jaxlib version, so a
 hit is the same program; the keys are stable across processes only while the traced programs

@@ -158,7 +158,8 @@ def test_traced_calls_and_debugging_flags_are_not_exported(folder):
     """Under `grad` the solver is traced as usual (its implicit derivative: d Σx/dt = 4 for
     x = t·1 in R⁴); under `disable_jit` it runs op by op."""
     problem = dg.Problem(lambda x, p: jnp.sum((x - p["t"]) ** 2), np.zeros(4), params={"t": 1.0})
-    assert float(jax.grad(lambda t: jnp.sum(solve(problem.with_params({"t": t})).x))(2.0)) == pytest.approx(4.0, abs=1e-12)
+    derivative = jax.grad(lambda t: jnp.sum(solve(problem.with_params({"t": t})).x))(2.0)
+    assert float(derivative) == pytest.approx(4.0, abs=1e-12)
     with jax.disable_jit():
         solve(quadratic(scale=3.0))
     assert list(folder.glob("*")) == []
