@@ -91,15 +91,26 @@ def _group(c: Check) -> str:
     return getattr(sys.modules[c.fn.__module__], "GROUP", c.fn.__module__)
 
 
-def _run_names(modules: list[str], names: list[str], out: str, quick: bool, queue=None) -> list[dict]:
+_PROGRESS = None
+"""In a worker process: the queue its outcomes' status lines go to (`_started_worker`)."""
+
+
+def _started_worker(progress) -> None:
+    """A worker's initialiser: keep the progress queue (a multiprocessing queue is handed to a
+    process when it starts, not with each task)."""
+    global _PROGRESS
+    _PROGRESS = progress
+
+
+def _run_names(modules: list[str], names: list[str], out: str, quick: bool) -> list[dict]:
     """Worker of the parallel run: import `modules`, run the checks `names`, return plain data."""
     for module in modules:
         importlib.import_module(module)
     results = []
     for name in names:
         outcome = run_check(registry[name], Path(out), quick)
-        if queue is not None:
-            queue.put(_status(outcome))
+        if _PROGRESS is not None:
+            _PROGRESS.put(_status(outcome))
         results.append({k: getattr(outcome, k) for k in ("value", "passed", "seconds", "sizes", "figures", "tables",
                                                          "error", "skipped")} | {"name": name})
     return results
@@ -126,19 +137,21 @@ def _workers(jobs: int):
     # there (unless XLA_FLAGS is set already).
     os.environ.setdefault("XLA_FLAGS", compile_cache.fast_compile_xla_flags())
     context = multiprocessing.get_context("spawn")
-    with context.Manager() as manager:
-        pool = ProcessPoolExecutor(jobs, mp_context=context)
-        try:
-            for _ in range(jobs):
-                pool.submit(_warm_up)
-            yield pool, manager.Queue()
-        finally:
-            # idle now (or after an error): stop the workers instead of waiting for their JAX to
-            # shut down, seconds with thousands of compiled programs (no public API for this)
-            processes = list((getattr(pool, "_processes", None) or {}).values())
-            pool.shutdown(wait=False, cancel_futures=True)
-            for process in processes:
-                process.terminate()
+    progress = context.Queue()
+    pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=_started_worker, initargs=(progress,))
+    try:
+        for _ in range(jobs):
+            pool.submit(_warm_up)
+        yield pool, progress
+    finally:
+        # idle now (or after an error): stop the workers instead of waiting for their JAX to
+        # shut down, seconds with thousands of compiled programs (no public API for this)
+        processes = list((getattr(pool, "_processes", None) or {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            process.terminate()
+        progress.close()
+        progress.cancel_join_thread()
 
 
 def _run_parallel(checks: list[Check], out, quick: bool, workers, advance) -> list[Outcome]:
@@ -151,12 +164,15 @@ def _run_parallel(checks: list[Check], out, quick: bool, workers, advance) -> li
         groups.setdefault(_group(c), []).append(c)
     tasks = sorted(groups.values(), key=len, reverse=True)
     futures = [pool.submit(_run_names, sorted({c.fn.__module__ for c in task}), [c.name for c in task], str(out),
-                           quick, queue) for task in tasks]
-    while not all(f.done() for f in futures) or not queue.empty():
+                           quick) for task in tasks]
+    received = 0  # status lines: one per check, unless its worker died
+    while received < len(checks):
         try:
             advance(queue.get(timeout=0.5))
+            received += 1
         except Empty:
-            pass
+            if all(f.done() for f in futures):  # and nothing arrived for 0.5 s: a worker failed
+                break
     results = {}
     for task, future in zip(tasks, futures, strict=True):
         for c, row in zip(task, _rows(task, future, quick), strict=True):
