@@ -159,6 +159,11 @@ class Term:
         vals = _on_cells(self.fn, "value", x[self.stencil], self.data, params)
         return vals.sum(axis=0) if self.reduce == "sum" else vals.reshape(-1)
 
+    def __repr__(self) -> str:
+        """The density's name and the stencil's shape (not its entries: JAX formats the functions
+        it traces, and a printed stencil costs milliseconds per trace)."""
+        return f"Term({getattr(self.fn, '__name__', type(self.fn).__name__)}, stencil {self.stencil.shape}, {self.reduce})"
+
     def key(self) -> tuple:
         """Hashable description of the sparsity (the function by identity, the stencil by value)."""
         data_leaves = tuple(np.asarray(leaf).tobytes() for leaf in jax.tree_util.tree_leaves(self.data))
@@ -183,6 +188,9 @@ class Local:
     def __post_init__(self):
         # the declaration is immutable: its hash (over the stencils' bytes) is computed once
         object.__setattr__(self, "hash_value", hash(self.key()))
+
+    def __repr__(self) -> str:
+        return f"Local({', '.join('[' + ', '.join(map(repr, g)) + ']' for g in self.groups)}, names={self.names})"
 
     def __call__(self, x, params=None):
         if is_concrete((x, params)):  # called eagerly (not by a solver): one program per shape
