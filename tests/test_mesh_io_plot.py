@@ -88,3 +88,40 @@ def test_surface_plot_shows_the_faces_coloured_by_curvature(tmp_path):
     path = plot_surface.surface(V, F, tmp_path / "torus.png", color_by="mean_curvature")
     assert path == tmp_path / "torus.png"
     assert plt.imread(path).shape == (495, 550, 4)  # 5 × 4.5 in at 110 dpi
+
+
+@pytest.mark.parametrize("label, plain", [
+    (r"$\mathdefault{10^{-3}}$", "10⁻³"),
+    (r"$\mathdefault{2\times10^{-4}}$", "2×10⁻⁴"),
+    (r"$\mathdefault{10^{12}}$", "10¹²"),
+    (r"$\mathdefault{-10^{2}}$", "−10²"),
+    (r"$\mathdefault{0.5}$", "0.5"),
+    ("", ""),
+    (r"$\alpha$", r"$\alpha$"),  # not a number: left to mathtext
+])
+def test_log_tick_labels_as_plain_text(label, plain):
+    from ddgjax.plot._figure import plain_number
+
+    assert plain_number(label) == plain
+
+
+def test_log_axes_are_labelled_without_mathtext(tmp_path):
+    """The labels of a log-log figure's ticks are matplotlib's values (decades, and 2×10ⁿ … on
+    an axis spanning under a decade) written as plain text; a formatter a caller set is kept."""
+    from matplotlib.ticker import FormatStrFormatter
+
+    from ddgjax.plot._figure import plain_number, pyplot, save_figure
+
+    plt = pyplot()
+    fig, (ax, kept) = plt.subplots(1, 2)
+    ax.loglog([8, 16, 32], [1e-3, 2.4e-4, 6e-5], "o-")
+    kept.loglog([1, 2], [1, 2])
+    kept.yaxis.set_major_formatter(FormatStrFormatter("%.1f"))
+    fig.canvas.draw()
+    default = [t.get_text() for t in ax.get_yticklabels() + ax.xaxis.get_minorticklabels()]
+    assert any("$" in label for label in default)  # negative control: matplotlib's own labels are mathtext
+    save_figure(fig, tmp_path / "loglog.png")
+    labels = [t.get_text() for t in ax.get_yticklabels() + ax.xaxis.get_minorticklabels()]
+    assert labels == [plain_number(label) for label in default]
+    assert "10⁻⁴" in labels and "2×10¹" in labels and not any("$" in label for label in labels)
+    assert isinstance(kept.yaxis.get_major_formatter(), FormatStrFormatter)
