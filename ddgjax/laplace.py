@@ -49,6 +49,7 @@ from .mesh.lengths import (
     corner_weights,
     dirichlet_energy,
     normalised,
+    on_padded_rows,
     scaled_back,
     squared_side_lengths,
     stiffness,
@@ -79,15 +80,15 @@ def triangle_dirichlet_energy(f: Float[Array, "3"], P: Float[Array, "3 n"]) -> F
 
 
 @jax.jit
-def _corner_weights_of_positions(V, F):
+def _corner_weights_of_squares(l2):
     """(nf, 3) ½ cot α_k derived by autodiff (`mesh.lengths.corner_weights`) and sin² of each
-    face's angle at corner 0, for the triangles of (V, F)."""
-    return corner_weights(squared_side_lengths(V[F]))
+    face's angle at corner 0, for the triangles with squared sides l2 (nf, 3)."""
+    return corner_weights(l2)
 
 
 @jax.jit
-def _stiffness_of_positions(V, F):
-    l2 = squared_side_lengths(V[F])
+def _stiffness_of_squares(l2):
+    """(nf, 3, 3) `mesh.lengths.stiffness` and sin² of each face's angle at corner 0."""
     return stiffness(l2), corner_weights(l2)[1]
 
 
@@ -124,15 +125,18 @@ def triangle_stiffness(V, F) -> np.ndarray:
 
     **Raises:** as `checked_triangle_mesh`, and `DegenerateFaceError` naming a zero-area face.
     """
-    return _per_face(_stiffness_of_positions, V, F)[0]
+    return _per_face(_stiffness_of_squares, V, F)[0]
 
 
 def _per_face(kernel, V, F) -> tuple[np.ndarray, np.ndarray]:
-    """`(kernel's per-face output, F)` for a validated mesh whose faces all have non-zero area;
-    the kernel's output must be invariant under V ↦ sV (it sees V / s, `normalised`)."""
+    """`(kernel's per-face output, F)` for a validated mesh whose faces all have non-zero area.
+
+    The kernel maps the faces' squared side lengths (nf, 3), those of V / s (`normalised`; its
+    output must be invariant under V ↦ sV), to (per-face output, sin² of each face's angle at
+    corner 0); it runs on the rows padded to `padded_size(nf)` (`on_padded_rows`), so that
+    meshes of nearby sizes share its compiled program."""
     V, F = checked_triangle_mesh(V, F)
-    out, sin2 = kernel(normalised(V)[0], F)
-    out, sin2 = np.asarray(out), np.asarray(sin2)
+    out, sin2 = on_padded_rows(kernel, squared_side_lengths(normalised(V)[0][F]))
     check_face_areas(sin2, F)
     return out, F
 
@@ -140,12 +144,12 @@ def _per_face(kernel, V, F) -> tuple[np.ndarray, np.ndarray]:
 def check_nondegenerate(V, F) -> None:
     """Raise `DegenerateFaceError` naming the first face of zero area (sin of its angle at
     corner 0 below ~1e-7), after the checks of `checked_triangle_mesh`."""
-    _per_face(_corner_weights_of_positions, V, F)
+    _per_face(_corner_weights_of_squares, V, F)
 
 
 def _corner_weights(V, F) -> tuple[np.ndarray, np.ndarray]:
     """Each face's contribution ½ cot α_k to the edge opposite corner k, (nf, 3), and F."""
-    return _per_face(_corner_weights_of_positions, V, F)
+    return _per_face(_corner_weights_of_squares, V, F)
 
 
 @dataclass(frozen=True, eq=False)
