@@ -30,6 +30,7 @@ from scipy.sparse.linalg import splu
 
 import ddgjax as dg
 from ddgjax._checks import check_finite, concrete_value
+from ddgjax._host import namespace
 from ddgjax._host import namespace, with_set
 from ddgjax.errors import NonUniqueSolutionError, ShapeError
 from ddgjax.laplace import (
@@ -138,7 +139,7 @@ def cotan(V, F, boundary, values) -> dg.Problem:
     `DegenerateFaceError` (zero-area face), `MeshError` / `NonManifoldError` (naming the face,
     edge or vertex).  Positions are checked when concrete.
     """
-    V = jnp.asarray(V, dtype=float)
+    V = namespace(V).asarray(V, dtype=float)  # NumPy when concrete: V[F] gathers without compiling
     F, L = _mesh_laplacian(V, F)
     energy = dg.local_sum(_face_term, F, data=np.arange(len(F)))
     name = f"cotan Dirichlet energy (nv={V.shape[0]}, nf={len(F)})"

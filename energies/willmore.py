@@ -172,7 +172,7 @@ def mean_curvature(V, F) -> tuple[np.ndarray, np.ndarray]:
     **Raises:** as `helfrich`."""
     V, F = _closed(V, F)
     stencil, data = star_stencil(F, len(V))
-    H, A = _mean_curvatures(jnp.asarray(V)[stencil], jax.tree_util.tree_map(jnp.asarray, data))
+    H, A = _mean_curvatures(np.asarray(V)[stencil], data)  # host arrays: gathered in NumPy, nothing compiled
     return np.asarray(H), np.asarray(A)
 
 

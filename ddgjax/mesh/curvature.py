@@ -195,7 +195,7 @@ def angle_defect(V, F):
     vertex, nxt, prv = _corners(F)
     nv = jnp.shape(V)[0]
     boundary = _boundary_vertices(vertex, nxt, nv) if h is None else h.boundary_vertex_mask
-    return _angle_defect_kernel(jnp.asarray(V), vertex, nxt, prv, boundary, triangles=_is_triangle_array(F))
+    return _angle_defect_kernel(namespace(V).asarray(V), vertex, nxt, prv, boundary, triangles=_is_triangle_array(F))
 
 
 @partial(jax.jit, static_argnames="triangles")
@@ -306,7 +306,7 @@ def _dihedral_angles_and_edges(V, F):
     V = jnp.asarray(V) * (1.0 / s)
     _check_areas(V, F, N)
     theta = _signed_dihedral(N, V, h.vertex[h1], h.head[h1], f1, f2)
-    return jnp.where(jnp.asarray(inner), theta, 0.0), h.edges, V, s
+    return namespace(V, theta).where(inner, theta, 0.0), h.edges, V, s
 
 
 @jax.jit

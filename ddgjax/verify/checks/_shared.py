@@ -89,3 +89,9 @@ def euclidean_motion_residual(points, velocities, extra=None) -> float:
 def unit_rows(X) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     return X / np.linalg.norm(X, axis=-1, keepdims=True)
+
+
+def max_abs(a, b=0.0) -> float:
+    """max |a − b| over the entries, in NumPy: the checks reduce concrete arrays, where each
+    `jax.numpy` operation on a shape not seen before would compile a program of its own."""
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b)), initial=0.0))

@@ -14,6 +14,8 @@ from ddgjax.smooth import curve_flows as smooth
 from ddgjax.verify import check
 from energies import heisenberg
 
+from ._shared import max_abs
+
 ORDER_2 = dict(target=2.0, within=0.1)
 
 
@@ -29,7 +31,7 @@ def closed_curve(n: int):
     gamma, s = curves.sample(latitude_longitude_curve, n, length=2 * np.pi, closed=True, equal_chords=True,
                              return_parameters=True)
     eps = float(np.mean(np.asarray(curves.edge_lengths(gamma, closed=True))))
-    return jnp.asarray(gamma) / eps, eps, np.asarray(s)
+    return np.asarray(gamma) / eps, eps, np.asarray(s)
 
 
 def _length_rates(gamma, fields) -> np.ndarray:
@@ -37,7 +39,7 @@ def _length_rates(gamma, fields) -> np.ndarray:
     velocity field u = fields[j] (m, N, 3) of the closed curve γ: the rigidity matrix (the
     Jacobian of the squared edge lengths, by autodiff) applied to the fields."""
     squared = lambda g: curves.edge_lengths(g, closed=True) ** 2  # noqa: E731
-    return np.einsum("eni,mni->em", np.asarray(jax.jacfwd(squared)(gamma)), np.asarray(fields))
+    return np.einsum("eni,mni->em", np.asarray(jax.jit(jax.jacfwd(squared))(gamma)), np.asarray(fields))
 
 
 def _edge_length_rate(flow, gamma) -> float:
@@ -61,7 +63,7 @@ def heisenberg_flow_keeps_lengths(ctx, n):
        quantity="max |[v, w]| = |Dw·v − Dv·w|", at_most=1e-12, quick=dict(n=24))
 def heisenberg_commutes_with_tangent_flow(ctx, n):
     gamma = closed_curve(n)[0]
-    return float(jnp.max(jnp.abs(dg.lie_bracket(curves.tangent_flow, curves.heisenberg_flow)(gamma))))
+    return max_abs(dg.lie_bracket(curves.tangent_flow, curves.heisenberg_flow)(gamma))
 
 
 @check("eq (2.14), Remark A.1", "on the tangents, the Heisenberg flow is the integrable spin chain with J = −1/2",
@@ -69,7 +71,7 @@ def heisenberg_commutes_with_tangent_flow(ctx, n):
 def heisenberg_flow_on_tangents_is_spin_chain(ctx, n):
     gamma = closed_curve(n)[0]
     dT = _tangents_moved_by(curves.heisenberg_flow, gamma)
-    return float(jnp.max(jnp.abs(dT - heisenberg.flow("integrable", -0.5)(curves.edge_vectors(gamma, closed=True)))))
+    return max_abs(dT, jax.jit(heisenberg.flow("integrable", -0.5))(curves.edge_vectors(gamma, closed=True)))
 
 
 _heisenberg_flow = jax.jit(curves.heisenberg_flow)  # one compilation per n, not one per operation
@@ -94,7 +96,7 @@ def heisenberg_flow_smooth_limit(ctx, ns):
     def error(n):
         gamma, eps, s = closed_curve(n)
         # w is homogeneous of degree 0 in γ: the flow of the unit-edge curve is that of γ
-        return float(jnp.max(jnp.abs(2 / eps * _heisenberg_flow(gamma) - _smooth_binormal(s))))
+        return max_abs(2 / eps * np.asarray(_heisenberg_flow(gamma)), _smooth_binormal(s))
 
     table = dg.limits.convergence(error, ns, label="‖(2/ε) w_k − T′ × T‖∞")
     return ctx.convergence(table, "convergence_heisenberg_flow").fitted_order
@@ -105,8 +107,8 @@ def heisenberg_flow_smooth_limit(ctx, ns):
 def bending_energy_smooth_limit(ctx, ns):
     def error(n):
         gamma, eps, _ = closed_curve(n)
-        T = curves.tangents(gamma, closed=True)
-        energy = jnp.sum(jax.vmap(curves.local_bending_energy)(jnp.roll(T, 1, axis=0), T))
+        T = np.asarray(curves.tangents(gamma, closed=True))
+        energy = np.sum(np.asarray(jax.jit(jax.vmap(curves.local_bending_energy))(np.roll(T, 1, axis=0), T)))
         return abs(4 / eps * float(energy) - 6 * np.pi)
 
     table = dg.limits.convergence(error, ns, label="error of (4/ε) Σ E_k")
@@ -251,7 +253,7 @@ def heisenberg_chain_smooth_limit(ctx, ns):
         gamma, eps, s = closed_curve(n)
         midpoints = (s + np.append(s[1:], s[0] + 2 * np.pi)) / 2
         dT = _tangents_moved_by(_heisenberg_flow, gamma)
-        return float(jnp.max(jnp.abs(2 / eps**2 * dT - _smooth_magnetic_chain(midpoints))))
+        return max_abs(2 / eps**2 * np.asarray(dT), _smooth_magnetic_chain(midpoints))
 
     table = dg.limits.convergence(error, ns, label="‖(2/ε²) ∂_t T_k − T″ × T‖∞")
     return ctx.convergence(table, "convergence_heisenberg_chain").fitted_order

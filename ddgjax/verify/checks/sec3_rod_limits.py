@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import functools
 
+import jax
 import jax.numpy as jnp
+import numpy as np
 
 import ddgjax as dg
 from ddgjax import quaternion as qt
@@ -20,19 +22,21 @@ from ddgjax.verify import check
 from energies import rod
 from solvers import solve
 
+from ._shared import max_abs
 from .sec3_rods import E1, E3, combined_flow_fit
 
 # --- vertex-clamped rods and the smooth rod (Thm 3.11, 3.13) -----------------------------------
 
 VERTEX_ALPHA, VERTEX_CHORD = 0.6, (0.5, 0.3, 0.15)
-VERTEX_END = qt.mul(qt.from_axis_angle(E3, 2.0), qt.from_axis_angle(E1, 1.5))
+VERTEX_END_TURNS = ((E3, 2.0), (E1, 1.5))  # the end frame: turned by 2 about e3 after 1.5 about e1
 QUICK_NS, FULL_NS = (8, 16, 32), (16, 32, 64, 128, 256)
 
 
 @functools.cache
 def vertex_clamped_rod(n: int):
     """`(problem, solution)` of the twisted 3D rod with second-order (vertex) clamps."""
-    problem = rod.clamped(n, alpha=VERTEX_ALPHA, chord=VERTEX_CHORD, frame_start=[1.0, 0, 0, 0], frame_end=VERTEX_END,
+    problem = rod.clamped(n, alpha=VERTEX_ALPHA, chord=VERTEX_CHORD, frame_start=[1.0, 0, 0, 0],
+                          frame_end=qt.mul(*(qt.from_axis_angle(axis, angle) for axis, angle in VERTEX_END_TURNS)),
                           clamp="vertex")
     return problem, solve(problem)
 
@@ -64,10 +68,10 @@ def rod_and_limit(n: int, shot_from: int | None):
         return (*vertex_clamped_rod(n), smooth)
 
     def unit(q):
-        return q / jnp.linalg.norm(q, axis=-1, keepdims=True)
+        return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
-    s = jnp.concatenate([jnp.array([0.0]), (jnp.arange(n) + 0.5) / n, jnp.array([1.0])]) * smooth.length
-    Phi, gamma = kirchhoff.sample(smooth, s)  # the start, the edge midpoints, the end
+    s = np.concatenate([[0.0], (np.arange(n) + 0.5) / n, [1.0]]) * smooth.length
+    Phi, gamma = (np.asarray(a) for a in kirchhoff.sample(smooth, s))  # the start, the edge midpoints, the end
     problem = rod.clamped(n, alpha=smooth.alpha, length=smooth.length, chord=gamma[-1], frame_start=unit(Phi[0]),
                           frame_end=unit(Phi[-1]), clamp="vertex", x0=unit(Phi[1:-1]))
     return problem, solve(problem), smooth
@@ -93,8 +97,8 @@ def rod_smooth_limit(ctx, ns, shot_from):
 def rod_is_a_top_motion(ctx, ns, shot_from):
     def residual(n):
         problem, sol, _ = rod_and_limit(n, shot_from)
-        r = kirchhoff.discrete_top_residual(sol.x, problem.params["h"], problem.params["alpha"], rod.load(sol))
-        return float(jnp.max(jnp.abs(r)))
+        return max_abs(kirchhoff.discrete_top_residual(sol.x, problem.params["h"], problem.params["alpha"],
+                                                       rod.load(sol)))
 
     return ctx.convergence(dg.limits.convergence(residual, list(ns)), "convergence_rod_top_residual").fitted_order
 
@@ -107,8 +111,7 @@ def rod_top_motion_wrong_load_fails(ctx, n, shot_from):
     problem, sol, _ = rod_and_limit(n, shot_from)
 
     def residual(a):
-        return float(jnp.max(jnp.abs(kirchhoff.discrete_top_residual(sol.x, problem.params["h"],
-                                                                     problem.params["alpha"], a))))
+        return max_abs(kirchhoff.discrete_top_residual(sol.x, problem.params["h"], problem.params["alpha"], a))
 
     return residual(-rod.load(sol)) / residual(rod.load(sol))
 
@@ -119,16 +122,16 @@ def thm_3_13_defects(jet: kirchhoff.RodJet, alpha: float, a, c_sign: float = -1.
     `torsion` max |τ − τ(0)|; `i` max |ω' − (1 − α)τT' − T × a|; `ii` the spread max |b − b(0)| of
     `b = T' × T + cT − a × γ` (`γ'' × γ' + cγ' = a × γ + b`); `iii` max |T'' × T + cT' − a × T|,
     the derivative of (ii) (`printed`: with cT in place of cT', as the reference prints (iii))."""
-    a = jnp.asarray(a)
-    tau = jnp.sum(jet.omega * jet.T, axis=1, keepdims=True)
+    a, jet = np.asarray(a), jax.tree_util.tree_map(np.asarray, jet)  # NumPy: concrete values, nothing to compile
+    tau = np.sum(jet.omega * jet.T, axis=1, keepdims=True)
     c = c_sign * alpha * tau
-    b = jnp.cross(jet.dT, jet.T) + c * jet.T - jnp.cross(a, jet.gamma)
-    iii = jnp.cross(jet.ddT, jet.T) + c * (jet.T if printed else jet.dT) - jnp.cross(a, jet.T)
+    b = np.cross(jet.dT, jet.T) + c * jet.T - np.cross(a, jet.gamma)
+    iii = np.cross(jet.ddT, jet.T) + c * (jet.T if printed else jet.dT) - np.cross(a, jet.T)
     return {
-        "torsion": float(jnp.max(jnp.abs(tau - tau[0]))),
-        "i": float(jnp.max(jnp.abs(jet.domega - (1 - alpha) * tau * jet.dT - jnp.cross(jet.T, a)))),
-        "ii": float(jnp.max(jnp.abs(b - b[0]))),
-        "iii": float(jnp.max(jnp.abs(iii))),
+        "torsion": max_abs(tau, tau[0]),
+        "i": max_abs(jet.domega - (1 - alpha) * tau * jet.dT - np.cross(jet.T, a)),
+        "ii": max_abs(b, b[0]),
+        "iii": max_abs(iii),
     }
 
 
@@ -136,7 +139,7 @@ def _smooth_jet(shot_from: int | None, samples: int):
     smooth = smooth_rod(shot_from)
     if abs(kirchhoff.torsion(smooth)) <= 0.1:
         raise AssertionError(f"τ = {kirchhoff.torsion(smooth):.2e}: the check needs a twisted rod")
-    return smooth, kirchhoff.jet(smooth, jnp.linspace(0.0, smooth.length, samples))
+    return smooth, kirchhoff.jet(smooth, np.linspace(0.0, smooth.length, samples))
 
 
 SMOOTH_QUICK, SMOOTH_FULL = dict(shot_from=None, samples=64), dict(shot_from=64, samples=256)  # multiples of kirchhoff.SAMPLE_BUCKET
@@ -147,7 +150,7 @@ SMOOTH_QUICK, SMOOTH_FULL = dict(shot_from=None, samples=64), dict(shot_from=64,
        quantity="max of the four defects / |a|", at_most=1e-10, quick=SMOOTH_QUICK, full=SMOOTH_FULL)
 def smooth_rod_euler_lagrange(ctx, shot_from, samples):
     smooth, jet = _smooth_jet(shot_from, samples)
-    return max(thm_3_13_defects(jet, smooth.alpha, smooth.a).values()) / float(jnp.linalg.norm(smooth.a))
+    return max(thm_3_13_defects(jet, smooth.alpha, smooth.a).values()) / float(np.linalg.norm(smooth.a))
 
 
 @check("Thm 3.13", "negative controls: (ii) with c = +ατ, and (iii) as printed (cT in place of cT'), fail",
@@ -156,7 +159,7 @@ def smooth_rod_wrong_c_fails(ctx, shot_from, samples):
     smooth, jet = _smooth_jet(shot_from, samples)
     wrong_sign = thm_3_13_defects(jet, smooth.alpha, smooth.a, c_sign=1.0)["ii"]
     printed = thm_3_13_defects(jet, smooth.alpha, smooth.a, printed=True)["iii"]
-    return min(wrong_sign, printed) / float(jnp.linalg.norm(smooth.a))
+    return min(wrong_sign, printed) / float(np.linalg.norm(smooth.a))
 
 
 @check("Thm 3.13, Def 3.7", "the coefficient c of Def 3.7 at vertex-clamped rods, as 2c/h, converges to the smooth "

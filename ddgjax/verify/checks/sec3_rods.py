@@ -14,21 +14,21 @@ from ddgjax.verify import check
 from energies import rod
 from solvers import solve
 
-from ._shared import euclidean_motion_fit, planar_elastica
+from ._shared import euclidean_motion_fit, max_abs, planar_elastica
 
 GROUP = "clamped elastica"  # share the solved elastica of _shared (one compilation per size)
 
-E1, E2, E3 = jnp.array([1.0, 0.0, 0.0]), jnp.array([0.0, 1.0, 0.0]), jnp.array([0.0, 0.0, 1.0])
-START = qt.from_axis_angle(E3, np.pi / 2)  # tangent e1 -> e2
-END = qt.from_axis_angle(E3, -np.pi / 2)  # tangent e1 -> -e2
+E1, E2, E3 = np.eye(3)
+START_ANGLE, END_ANGLE = np.pi / 2, -np.pi / 2  # the end frames' turns about e3: tangent e1 -> e2, e1 -> -e2
 CHORD, ALPHA, TWIST = 0.6, 0.7, 2.5
 
 
 def clamped_problem(n: int, twist: float, **options):
     """The rod from tangent e2 to −e2 with chord (0.6, 0, 0), the end frame twisted by `twist`
     (`options` go to `rod.clamped`)."""
-    end = qt.mul(qt.from_axis_angle(-E2, twist), END)
-    return rod.clamped(n, **{"alpha": ALPHA, **options}, chord=[CHORD, 0, 0], frame_start=START, frame_end=end)
+    end = qt.mul(qt.from_axis_angle(-E2, twist), qt.from_axis_angle(E3, END_ANGLE))
+    return rod.clamped(n, **{"alpha": ALPHA, **options}, chord=[CHORD, 0, 0], frame_start=qt.from_axis_angle(E3, START_ANGLE),
+                       frame_end=end)
 
 
 @functools.cache
@@ -53,7 +53,7 @@ def rod_twist_is_constant(ctx, n):
 def untwisted_rod_is_elastica(ctx, n):
     _, sol = clamped_rod(n, 0.0)
     _, curve = planar_elastica(n, CHORD)
-    return float(jnp.max(jnp.abs(rod.tangents(sol.x) - curve.x)))
+    return max_abs(rod.tangents(sol.x), curve.x)
 
 
 # --- Def 3.7 and Cor 3.14: Heisenberg flow + c · tangent flow ---------------------------------
@@ -133,7 +133,7 @@ def anisotropic_rod_equal_stiffnesses(ctx, n):
 
     def distance(beta):
         _, sol = anisotropic_rod(n, (beta, beta), beta * ALPHA)
-        return float(jnp.max(jnp.abs(sol.x - iso.x)) + jnp.max(jnp.abs(rod.load(sol) / beta - rod.load(iso))))
+        return max_abs(sol.x, iso.x) + max_abs(np.asarray(rod.load(sol)) / beta, rod.load(iso))
 
     return max(distance(1.0), distance(2.0))
 

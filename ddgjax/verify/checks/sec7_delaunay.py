@@ -347,9 +347,9 @@ _energies = jax.jit(jax.vmap(dg.laplace.triangle_dirichlet_energy))
 def _split_energy(P, u, triangles) -> np.ndarray:
     """(count,) Dirichlet energies of the interpolants affine on the two `triangles` of each quad."""
     t = np.array(triangles)
-    P3 = jnp.concatenate([P, jnp.zeros(P.shape[:2] + (1,))], axis=2)
+    P3 = np.concatenate([np.asarray(P), np.zeros(P.shape[:2] + (1,))], axis=2)
     per = [_energies(u[:, k], P3[:, k]) for k in t]
-    return np.asarray(per[0] + per[1])
+    return np.asarray(per[0]) + np.asarray(per[1])
 
 
 def _split_energy_direct(P, u, triangles) -> np.ndarray:

@@ -74,7 +74,7 @@ def area_gradient(V, F, boundary) -> np.ndarray:
     """(nv, 3) ∇A of the simplicial surface (V, F), A = Σ_F A(F) (`energies.area.face_area`) by
     autodiff, zero at the `boundary` vertices; Thm 6.7: ∇_{f(i)} A = (L f)(i), L the cotan
     Laplacian of (V, F)."""
-    gradient = np.array(jax.grad(dg.local_sum(face_area, np.asarray(F)))(np.asarray(V), None))
+    gradient = np.array(jax.jit(jax.grad(dg.local_sum(face_area, np.asarray(F))))(np.asarray(V), None))
     gradient[boundary] = 0.0
     return gradient
 
