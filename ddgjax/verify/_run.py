@@ -150,8 +150,10 @@ def _workers(jobs: int):
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             process.terminate()
+        for process in processes:
+            process.join(timeout=10)
+        pool.shutdown(wait=True)  # the pool's thread sees its workers gone and ends before the interpreter does
         progress.close()
-        progress.cancel_join_thread()
 
 
 def _run_parallel(checks: list[Check], out, quick: bool, workers, advance) -> list[Outcome]:
