@@ -303,7 +303,7 @@ def _dihedral_angles_and_edges(V, F):
     inner = h2 >= 0
     f1, f2 = h.face[h1], h.face[np.where(inner, h2, h1)]
     N, s = _normalised_area_vectors(V, F)
-    V = jnp.asarray(V) * (1.0 / s)
+    V = namespace(V).asarray(V) * (1.0 / s)
     _check_areas(V, F, N)
     theta = _signed_dihedral(N, V, h.vertex[h1], h.head[h1], f1, f2)
     return namespace(V, theta).where(inner, theta, 0.0), h.edges, V, s
