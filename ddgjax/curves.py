@@ -89,7 +89,7 @@ def _as_rows(x, name: str, noun: str, fewest: int) -> Array:
         if bad.size:
             k, j = (int(i) for i in bad[0])
             raise NonFiniteError(f"{name}: {noun} {k} has the non-finite coordinate {arr[k, j]} (index ({k}, {j}))")
-    return jnp.asarray(x, dtype=float)
+    return jax.device_put(arr) if is_concrete(x) else jnp.asarray(x, dtype=float)  # device_put compiles nothing
 
 
 def _as_curve(gamma, closed: bool, name: str = "gamma") -> Array:
@@ -128,11 +128,12 @@ def _validate(gamma, closed: bool, *, arc_length: bool = False, singular: str | 
     gamma = _as_curve(gamma, closed)
     if not is_concrete(gamma):
         return gamma
-    if message := _zero_edge_message(np.asarray(_edges(gamma, closed)), closed):
+    host = np.asarray(gamma)  # the checks in NumPy: no program compiled per number of vertices
+    if message := _zero_edge_message(_edges_of(host, closed), closed):
         raise SingularVertexError(f"{message}: the tangent T_k (Def 1.2) is undefined")
     if arc_length:
         check_arc_length(gamma, closed=closed)
-    if singular and (message := _antiparallel_message(*_vertex_pairs(np.asarray(_unit_tangents(gamma, closed)), closed),
+    if singular and (message := _antiparallel_message(*_vertex_pairs(_unit_tangents_of(host, closed), closed),
                                                       closed)):
         raise SingularVertexError(f"{message}, where {singular} divides by 1 + <T_k, T_k-1> = 0")
     return gamma
@@ -140,7 +141,7 @@ def _validate(gamma, closed: bool, *, arc_length: bool = False, singular: str | 
 
 def _irregularity(gamma, closed: bool) -> str | None:
     """Why `gamma` is not regular (Def 1.2: any three successive points differ), or None."""
-    E = np.asarray(edge_vectors(gamma, closed))
+    E = _edges_of(np.asarray(_as_curve(gamma, closed)), closed)
     if message := _zero_edge_message(E, closed):
         return message
     E_prev, E_next = _vertex_pairs(E, closed)
@@ -169,7 +170,7 @@ def _arc_length_defect(gamma, length, tol: float, closed: bool) -> str | None:
     check_positive(tol, "tol")
     if length is not None:
         check_positive(length, "length")
-    lengths = np.asarray(edge_lengths(gamma, closed))
+    lengths = _lengths_of(np.asarray(_as_curve(gamma, closed)), closed)  # NumPy: nothing compiled per size
     reference = float(np.median(lengths)) if length is None else float(length)
     bad = np.flatnonzero(~(np.abs(lengths - reference) <= tol * reference))
     if not bad.size:
@@ -221,34 +222,47 @@ def _on_vertices(V: Array, closed: bool) -> Array:
 
 
 def _norm(x: Array) -> Array:
-    """Euclidean norm over the last axis, with gradient 0 (not NaN) at 0 (straight vertices)."""
-    sq = jnp.sum(x * x, axis=-1)
+    """Euclidean norm over the last axis, with gradient 0 (not NaN) at 0 (straight vertices);
+    NumPy for a NumPy x."""
+    xp = np if isinstance(x, np.ndarray) else jnp
+    sq = xp.sum(x * x, axis=-1)
     positive = sq > 0
-    return jnp.where(positive, jnp.sqrt(jnp.where(positive, sq, 1.0)), 0.0)
+    return xp.where(positive, xp.sqrt(xp.where(positive, sq, 1.0)), 0.0)
 
 
-@_jit
-def _edges(gamma: Array, closed: bool) -> Array:
-    ends = jnp.concatenate([gamma[1:], gamma[:1]]) if closed else gamma[1:]
+def _edges_of(gamma: Array, closed: bool) -> Array:
+    """Δγ_k = γ_{k+1} − γ_k; NumPy for a NumPy γ (`_edges` is the compiled call)."""
+    xp = np if isinstance(gamma, np.ndarray) else jnp
+    ends = xp.concatenate([gamma[1:], gamma[:1]]) if closed else gamma[1:]
     return ends - gamma[: len(ends)]
+
+
+_edges = _jit(_edges_of)
 
 
 def _normalised_lengths(gamma: Array, closed: bool) -> tuple[Array, Array]:
     """`(|Δγ_k| / s, s)`: the edge lengths of γ / s (`ddgjax.mesh.lengths.normalised`)."""
     gamma, s = normalised(gamma)
-    return _norm(_edges(gamma, closed)), s
+    return _norm(_edges_of(gamma, closed)), s
 
 
-@_jit
-def _lengths(gamma: Array, closed: bool) -> Array:
+def _lengths_of(gamma: Array, closed: bool) -> Array:
+    """|Δγ_k|; NumPy for a NumPy γ (`_lengths` is the compiled call)."""
     lengths, s = _normalised_lengths(gamma, closed)
     return lengths * s
 
 
-@_jit
-def _unit_tangents(gamma: Array, closed: bool) -> Array:
-    E = _edges(normalised(gamma)[0], closed)
+_lengths = _jit(_lengths_of)
+
+
+def _unit_tangents_of(gamma: Array, closed: bool) -> Array:
+    """T_k = Δγ_k / |Δγ_k| (of γ / s, `normalised`); NumPy for a NumPy γ (`_unit_tangents` is
+    the compiled call)."""
+    E = _edges_of(normalised(gamma)[0], closed)
     return E / _norm(E)[:, None]
+
+
+_unit_tangents = _jit(_unit_tangents_of)
 
 
 @_jit
