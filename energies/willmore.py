@@ -463,7 +463,7 @@ def circle_angles(V, F) -> tuple[np.ndarray, np.ndarray]:
     """`(edges, β)`: the `edge_stencil` (ne, 4) of the closed surface (V, F) and the angles β_e (ne,)."""
     V, F = _closed(V, F)
     E = edge_stencil(F)
-    return E, np.asarray(_circle_angles(jnp.asarray(V)[E]))
+    return E, np.asarray(_circle_angles(np.asarray(V)[E]))
 
 
 _circle_angles = jax.jit(jax.vmap(circle_angle))

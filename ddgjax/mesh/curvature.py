@@ -162,7 +162,7 @@ def corner_angles(V, F):
     **Raises:** as `angle_defect`; scale-invariant (module docstring).
     """
     _validate(V, F)
-    angles = _angles_at_corners(jnp.asarray(V), *_corners(F), triangles=_is_triangle_array(F))
+    angles = _angles_at_corners(namespace(V).asarray(V), *_corners(F), triangles=_is_triangle_array(F))
     return angles.reshape(jnp.shape(F)) if hasattr(F, "shape") else angles
 
 
@@ -239,7 +239,7 @@ def _normalised_area_vectors(V, F):
         vertex, nxt, _ = _corners(F)
         n_faces, k = jnp.shape(F)
         face = np.repeat(np.arange(n_faces), k)
-    V, s = normalised(jnp.asarray(V))
+    V, s = normalised(namespace(V).asarray(V))
     return _area_vectors(V, vertex, nxt, face, n_faces), s
 
 

@@ -29,6 +29,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from .._checks import concrete_value, is_concrete
+from .._host import namespace
 from ..errors import (
     DegenerateFaceError,
     InvalidInputError,
@@ -429,7 +430,7 @@ def edge_lengths(V, F):
     h = from_faces(np.asarray(F), n_vertices=jnp.shape(V)[0])
     check_has_faces(h.n_faces)
     E = h.edges
-    lengths, s = _lengths(jnp.asarray(V), E)
+    lengths, s = _lengths(namespace(V).asarray(V), E)
     return scaled_back(lengths, s, 1, "an edge length")
 
 
