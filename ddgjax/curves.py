@@ -83,13 +83,14 @@ def _as_rows(x, name: str, noun: str, fewest: int) -> Array:
     if shape[0] < fewest:
         plural = "vertices" if noun == "vertex" else noun + "s"
         raise ShapeError(f"{name} needs at least {fewest} {plural}, got {shape[0]}")
-    if is_concrete(x):
-        arr = np.asarray(x, dtype=float)
-        bad = np.argwhere(~np.isfinite(arr))
-        if bad.size:
-            k, j = (int(i) for i in bad[0])
-            raise NonFiniteError(f"{name}: {noun} {k} has the non-finite coordinate {arr[k, j]} (index ({k}, {j}))")
-    return jax.device_put(arr) if is_concrete(x) else jnp.asarray(x, dtype=float)  # device_put compiles nothing
+    if not is_concrete(x):
+        return jnp.asarray(x, dtype=float)
+    arr = np.asarray(x, dtype=float)
+    bad = np.argwhere(~np.isfinite(arr))
+    if bad.size:
+        k, j = (int(i) for i in bad[0])
+        raise NonFiniteError(f"{name}: {noun} {k} has the non-finite coordinate {arr[k, j]} (index ({k}, {j}))")
+    return jax.device_put(arr)  # not jnp.asarray, which compiles a program per shape
 
 
 def _as_curve(gamma, closed: bool, name: str = "gamma") -> Array:
@@ -223,16 +224,16 @@ def _on_vertices(V: Array, closed: bool) -> Array:
 
 def _norm(x: Array) -> Array:
     """Euclidean norm over the last axis, with gradient 0 (not NaN) at 0 (straight vertices);
-    NumPy for a NumPy x."""
-    xp = np if isinstance(x, np.ndarray) else jnp
+    NumPy for concrete x (`namespace`)."""
+    xp = namespace(x)
     sq = xp.sum(x * x, axis=-1)
     positive = sq > 0
     return xp.where(positive, xp.sqrt(xp.where(positive, sq, 1.0)), 0.0)
 
 
 def _edges_of(gamma: Array, closed: bool) -> Array:
-    """Δγ_k = γ_{k+1} − γ_k; NumPy for a NumPy γ (`_edges` is the compiled call)."""
-    xp = np if isinstance(gamma, np.ndarray) else jnp
+    """Δγ_k = γ_{k+1} − γ_k; NumPy for concrete γ (`_edges` is the compiled call)."""
+    xp = namespace(gamma)
     ends = xp.concatenate([gamma[1:], gamma[:1]]) if closed else gamma[1:]
     return ends - gamma[: len(ends)]
 
