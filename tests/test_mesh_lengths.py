@@ -3,6 +3,7 @@ the autodiff Hessian of the Dirichlet energy on squared lengths, against the typ
 formula as an independent oracle, extrinsically (Def 6.2), intrinsically and after edge flips
 (Def 7.8)."""
 
+import jax
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -135,6 +136,29 @@ def test_side_cotangent_columns_are_the_derived_stiffness_by_side():
     np.testing.assert_array_equal(cot, rows)
     l = np.sqrt(l2)
     np.testing.assert_array_equal(area, lengths.triangle_area(l[:, 0], l[:, 1], l[:, 2]))
+
+
+def test_kernels_on_concrete_triangles_compile_two_programs_for_every_size():
+    """Triangles padded to `padded_size` and run in blocks of `TRIANGLE_BLOCKS[-1]`: meshes of
+    8 sizes from 10 to 5000 faces compile at most two programs of a kernel (one per size would
+    be 8), and the blocked results equal the kernel on the unpadded rows (per-face arithmetic,
+    to the last bit)."""
+    from ddgjax import laplace
+
+    kernel = laplace._corner_weights_of_squares
+    rng = np.random.default_rng(4)
+    sizes = (10, 100, 255, 256, 257, 1000, 2049, 5000)
+    assert {lengths.padded_size(n) for n in sizes} == {256, 2048, 4096, 6144}
+    triangles = [lengths.squared_side_lengths(rng.normal(size=(n, 3, 3))) for n in sizes]
+    before = kernel._cache_size()
+    blocked = [lengths.on_padded_rows(kernel, l2) for l2 in triangles]
+    assert kernel._cache_size() - before <= 2
+    reference = jax.jit(lengths.corner_weights)
+    for l2, (w, sin2) in zip(triangles, blocked):
+        expected = reference(l2)
+        assert w.shape == (len(l2), 3) and sin2.shape == (len(l2),)
+        np.testing.assert_array_equal(w, np.asarray(expected[0]))
+        np.testing.assert_array_equal(sin2, np.asarray(expected[1]))
 
 
 def test_dirichlet_energy_on_lengths_equals_the_cotangent_form():

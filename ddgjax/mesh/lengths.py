@@ -307,40 +307,61 @@ def corner_weights(l2: Float[Array, "nf 3"]):
     return _off_diagonal(_stiffness(l2)), _sin2(l2)
 
 
+TRIANGLE_BLOCKS = (256, 2048)
+"""The numbers of triangles the compiled kernels of this module run on at once (`padded_size`):
+two programs per kernel for meshes of every size."""
+
+
 def padded_size(n: int) -> int:
-    """The number of triangles the compiled kernels of this module run on for n: n rounded up
-    to 2^k or 3·2^(k−1), two sizes per octave (at most 50 % more, at least 64), so that they
-    compile for few shapes (the extra ones are equilateral, all sides 1).  The kernels run once
-    per call on concrete values, in microseconds per thousand triangles; a shape not compiled
-    yet costs a trace and a compilation, about 0.1 s."""
-    if n <= 64:
-        return 64
-    step = 1 << (n.bit_length() - 2)
-    return -(-n // step) * step
+    """The number of triangles the compiled kernels of this module run on for n: the first of
+    `TRIANGLE_BLOCKS` ≥ n, or n rounded up to a multiple of the last (run block by block,
+    `_blockwise`); the extra triangles are equilateral, all sides 1.  A kernel thus compiles two
+    programs whatever the sizes of the meshes (a shape not compiled yet costs a trace and a
+    compilation, 0.05–0.2 s for the derived cotangents), and runs in about a millisecond per
+    block of 2048 triangles."""
+    small, block = TRIANGLE_BLOCKS
+    return small if n <= small else -(-n // block) * block
+
+
+def _blockwise(kernel, X: np.ndarray, n: int, axis: int):
+    """`kernel` on X, whose `axis` has `padded_size` entries, in blocks of `TRIANGLE_BLOCKS[-1]`
+    along that axis; outputs (NumPy) joined along their first axis for rows (`axis` 0) or their
+    last for columns, and cut back to n entries there."""
+    width = X.shape[axis]
+    block = min(width, TRIANGLE_BLOCKS[-1])
+    cut = (lambda a: a[:n]) if axis == 0 else (lambda a: a[..., :n])
+    def run(start: int):
+        part = X[start : start + block] if axis == 0 else X[:, start : start + block]
+        return jax.tree_util.tree_map(np.asarray, kernel(np.ascontiguousarray(part)))
+
+    parts = [run(start) for start in range(0, width, block)]
+    if len(parts) == 1:
+        return jax.tree_util.tree_map(cut, parts[0])
+    join = (lambda *a: np.concatenate(a)) if axis == 0 else (lambda *a: np.concatenate(a, axis=-1))
+    return jax.tree_util.tree_map(lambda *a: cut(join(*a)), *parts)
 
 
 def on_padded_rows(kernel, X):
     """`kernel(X)` for X (n, 3) with the rows padded by equilateral triangles (ones) up to
-    `padded_size(n)`, so that a jitted kernel compiles for few shapes; outputs cut back to n rows."""
+    `padded_size(n)` and run in blocks (`_blockwise`), so that a jitted kernel compiles for two
+    shapes; outputs cut back to n rows."""
     X = np.asarray(X)
     n = X.shape[0]
     if padded_size(n) > n:
         X = np.concatenate([X, np.ones((padded_size(n) - n, 3), dtype=X.dtype)])
-    return jax.tree_util.tree_map(lambda a: np.asarray(a)[:n], kernel(X))
+    return _blockwise(kernel, X, n, 0)
 
 
 def _on_padded_columns(kernel, X, n: int | None = None):
     """`kernel(X)` for X (3, m) holding n ≤ m triangles (default m) in its first n columns, the
     columns padded by equilateral triangles (ones) up to `padded_size(n)` unless X has those
-    already; outputs cut back to n columns (their last axis)."""
+    already, run in blocks (`_blockwise`); outputs cut back to n columns (their last axis)."""
     X = np.asarray(X)
     n = X.shape[1] if n is None else n
     width = padded_size(n)
     if X.shape[1] != width:
         X = np.concatenate([X[:, :n], np.ones((3, width - n), dtype=X.dtype)], axis=1)
-    if X.flags.c_contiguous and X.flags.writeable:
-        X = jnp.from_dlpack(X)  # XLA reads the numpy buffer itself (if aligned; else a copy)
-    return jax.tree_util.tree_map(lambda a: np.asarray(a)[..., :n], kernel(X))
+    return _blockwise(kernel, X, n, 1)
 
 
 def _cotangents_of_columns(s2):
