@@ -87,11 +87,14 @@ def is_chain(problem: Problem, spec: Spec) -> bool:
     return derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width)) is not None
 
 
-KLU_MAX = 500
-"""Unknowns + multipliers up to which `method="sparse"` takes KLU on meshes too.  Measured on the
-saddle grids of `benchmarks/scale.py` (s per Newton step, KLU vs Pardiso): N = 432: 3.4 vs 4.5 ms,
-N = 588: 5.8 vs 5.3 ms, N = 972: 9.0 vs 6.7 ms.  KLU's solvers are also kept by the persistent
-compilation cache, Pardiso's host callbacks are not."""
+KLU_MAX = 3000
+"""Unknowns + multipliers up to which `method="sparse"` takes KLU on meshes too.  KLU's Newton
+solvers are kept on disk (`_exported`); `SparseDirect`'s host callbacks are not, so every new
+process traces and compiles them again.  Measured by `python benchmarks/klu_max.py` (surfaces of
+N = 487–7687: the time to a first solution in a new process with warm caches, KLU vs
+Pardiso): 0.25–0.5 s vs 2.2–3.5 s up to N ≈ 2,700, where a solve once compiled takes
+0.6–1.8 × Pardiso's time (tens of ms); at N = 7,687 the first solution takes about as long
+(2.7 vs 3.5 s) and KLU's fill makes each solve 5 × slower (2.2 vs 0.4 s)."""
 
 
 def sparse_direct_for(problem: Problem, spec: Spec) -> LinearSolver:

@@ -60,8 +60,8 @@ def test_sparse_back_ends_agree_on_a_minimal_surface(linear):
 def test_method_sparse_takes_klu_on_chains_and_small_meshes_and_sparse_direct_on_larger_meshes():
     from solvers._solve import KLU_MAX, linear_solver_of
 
-    chain = elastica.clamped(600, **CLAMPED)
-    small, large = (area.simplicial(*dg.mesh.saddle_grid(k)) for k in (8, 16))
+    chain = elastica.clamped(1200, **CLAMPED)
+    small, large = (area.simplicial(*dg.mesh.saddle_grid(k)) for k in (8, 40))
     assert spec_of(small).n <= KLU_MAX < spec_of(large).n and KLU_MAX < spec_of(chain).n + spec_of(chain).m
     assert isinstance(linear_solver_of(chain, spec_of(chain), "sparse", None), KLU)
     assert isinstance(linear_solver_of(small, spec_of(small), "sparse", None), KLU)
