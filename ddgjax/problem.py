@@ -76,7 +76,7 @@ class Problem:
     n_constraints: int = field(init=False, default=0)
 
     def __post_init__(self):
-        label = f"Problem {self.name!r}: " if self.name else ""
+        label = self._label()
         object.__setattr__(self, "x0", _as_float_tree(self.x0, label + "x0"))
         check_finite(self.params, label + "params")
         object.__setattr__(self, "fixed", _as_fixed(self.fixed, self.x0, label))
@@ -102,11 +102,42 @@ class Problem:
 
     def with_params(self, params: PyTree) -> "Problem":
         """The same problem with other parameters (e.g. inside `jax.vmap`)."""
-        return replace(self, params=params)
+        if not _same_types(params, self.params):
+            return replace(self, params=params)
+        check_finite(params, self._label() + "params")
+        return self._with(params=params)
 
     def with_x0(self, x0: PyTree) -> "Problem":
         """The same problem started from (or with boundary values taken from) `x0`."""
-        return replace(self, x0=x0)
+        if not _same_types(x0, self.x0):
+            return replace(self, x0=x0)
+        return self._with(x0=_as_float_tree(x0, self._label() + "x0"))
+
+    def _label(self) -> str:
+        return f"Problem {self.name!r}: " if self.name else ""
+
+    def _with(self, **checked) -> "Problem":
+        """A copy with the fields `checked` replaced by values already validated, whose trees,
+        shapes and dtypes are those of the fields they replace: the energy's and constraints'
+        output shapes, which the declaration's checks trace the functions to find, are the same
+        (a continuation or a parameter sweep makes one problem per point)."""
+        other = object.__new__(Problem)
+        other.__dict__.update(self.__dict__)
+        other.__dict__.update(checked)
+        return other
+
+
+def _same_types(tree, other) -> bool:
+    """Whether two pytrees have one structure and leaves of the same shapes, dtypes and weak
+    types (`jax.typeof`; traced leaves included)."""
+    leaves, treedef = jax.tree_util.tree_flatten(tree)
+    other_leaves, other_treedef = jax.tree_util.tree_flatten(other)
+    if treedef != other_treedef:
+        return False
+    try:
+        return all(jax.typeof(a) == jax.typeof(b) for a, b in zip(leaves, other_leaves, strict=True))
+    except TypeError:  # a leaf JAX does not type (a string): compare by the full checks
+        return False
 
 
 def _as_float_tree(x0, name: str):

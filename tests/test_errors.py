@@ -98,3 +98,30 @@ def test_bad_options():
 def test_sparse_requires_locality():
     with pytest.raises(DDGError, match="local_sum"):
         solve(dg.Problem(lambda x, _: jnp.sum(x**2), np.ones(2)), method="sparse")
+
+
+def test_with_params_and_with_x0_check_what_they_replace():
+    """`with_params` / `with_x0` keep the declaration's checks: non-finite values are named, a
+    copy of x0 is taken, and parameters of new shapes are checked against the energy (its
+    output shape is traced anew); with unchanged trees, shapes and dtypes nothing is traced."""
+    calls = []
+
+    def energy(x, p):
+        calls.append(1)
+        return p["a"] * jnp.sum(x**2)
+
+    problem = dg.Problem(energy, np.ones(3), params={"a": 2.0}, constraints=lambda x, p: x[:1] - p["a"])
+    traced = len(calls)
+    moved = problem.with_params({"a": 3.0})
+    assert len(calls) == traced and moved.params == {"a": 3.0} and problem.params == {"a": 2.0}
+    assert moved.constraint_structure == problem.constraint_structure and moved.n_constraints == 1
+    with pytest.raises(NonFiniteError, match=r"params\['a'\]"):
+        problem.with_params({"a": float("nan")})
+    with pytest.raises(NotScalarError):
+        problem.with_params({"a": np.ones(2)})  # a new shape is traced again: the energy is (2,)-shaped
+    x0 = np.array([1.0, 2.0, 3.0])
+    started = problem.with_x0(x0)
+    x0[0] = 5.0  # the problem holds a copy
+    assert np.asarray(started.x0).tolist() == [1.0, 2.0, 3.0]
+    with pytest.raises(NonFiniteError, match=r"x0 has the non-finite value inf at index \(1,\)"):
+        problem.with_x0(np.array([0.0, np.inf, 0.0]))
