@@ -33,6 +33,7 @@ from ..errors import MeshError, OrientationError, SingularVertexError
 from .connectivity import Halfedges, check_has_faces, checked_corners, faces_as_corners, from_faces
 from .lengths import check_positions
 from .lengths import (
+    angle_defects,
     check_face_areas,
     defect_from_angles,
     normalised,
@@ -192,6 +193,8 @@ def angle_defect(V, F):
     coincide.
     """
     h = _validate(V, F)
+    if h is not None and _is_triangle_array(F) and is_concrete(V):  # in NumPy, the angles in blocks
+        return angle_defects(h, np.sqrt(squared_side_lengths(normalised(np.asarray(V, dtype=float))[0][np.asarray(F)])))
     vertex, nxt, prv = _corners(F)
     nv = jnp.shape(V)[0]
     boundary = _boundary_vertices(vertex, nxt, nv) if h is None else h.boundary_vertex_mask

@@ -543,20 +543,30 @@ def corner_angles_from_lengths(F, lengths):
     return corner_angles(L) if not is_concrete(L) else jnp.asarray(corner_angles_of_sides(L))
 
 
-@jax.jit
+def _sums_at(values, index, n: int):
+    """(n,) Σ of `values` at each `index` (NumPy's `bincount` for concrete values, else
+    `jax.ops.segment_sum`)."""
+    if namespace(values, index) is np:
+        return np.bincount(np.asarray(index), weights=np.asarray(values), minlength=n)
+    return jax.ops.segment_sum(values, index, n)
+
+
 def defect_from_angles(angles, vertex, boundary):
     """K(p) = 2π − Σ α at interior vertices (Def 5.2), φ(p) = π − Σ α at boundary vertices
-    (Remark 5.4), from the flat corner angles, their vertices and the (nv,) boundary mask."""
-    total = jax.ops.segment_sum(angles, vertex, boundary.shape[0])
-    return jnp.where(boundary, jnp.pi, 2 * jnp.pi) - total
+    (Remark 5.4), from the flat corner angles, their vertices and the (nv,) boundary mask;
+    NumPy for concrete angles."""
+    xp = namespace(angles, vertex, boundary)
+    return xp.where(boundary, np.pi, 2 * np.pi) - _sums_at(angles, vertex, boundary.shape[0])
 
 
 def angle_defects(h, L):
     """(nv,) K(p) = 2π − Σ α at interior vertices and φ(p) = π − Σ α at boundary vertices (Def
     5.2, Remark 5.4, Thm 5.5) of the triangles of the connectivity `h` (`Halfedges`) with side
-    lengths L (nf, 3), L[f, k] opposite corner k."""
-    angles = (corner_angles(L) if not is_concrete(L) else corner_angles_of_sides(L)).reshape(-1)
-    return defect_from_angles(angles, jnp.asarray(h.vertex), jnp.asarray(h.boundary_vertex_mask))
+    lengths L (nf, 3), L[f, k] opposite corner k; NumPy for concrete L (its angles computed in
+    blocks, `corner_angles_of_sides`)."""
+    if is_concrete(L):
+        return defect_from_angles(corner_angles_of_sides(L).reshape(-1), h.vertex, h.boundary_vertex_mask)
+    return defect_from_angles(corner_angles(L).reshape(-1), jnp.asarray(h.vertex), jnp.asarray(h.boundary_vertex_mask))
 
 
 def angle_defect_from_lengths(F, lengths):
