@@ -39,7 +39,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from ._checks import check_positive, is_concrete
-from ._host import namespace
+from ._host import namespace, on_device
 from .errors import ArcLengthError, InvalidInputError, NonFiniteError, ShapeError, SingularVertexError
 from .mesh.lengths import normalised
 
@@ -266,15 +266,16 @@ def _unit_tangents_of(gamma: Array, closed: bool) -> Array:
 _unit_tangents = _jit(_unit_tangents_of)
 
 
-@_jit
 def _sin_cos(gamma: Array, closed: bool) -> tuple[Array, Array]:
-    """`(sin φ_k, cos φ_k)` of the turning angles from T_{k−1} to T_k; signed in the plane."""
-    T_prev, T_next = _vertex_pairs(_unit_tangents(gamma, closed), closed)
+    """`(sin φ_k, cos φ_k)` of the turning angles from T_{k−1} to T_k; signed in the plane;
+    NumPy for a NumPy γ (`namespace`)."""
+    xp = namespace(gamma)
+    T_prev, T_next = _vertex_pairs(_unit_tangents_of(gamma, closed), closed)
     if gamma.shape[-1] == 2:
         sin = T_prev[:, 0] * T_next[:, 1] - T_prev[:, 1] * T_next[:, 0]
     else:
-        sin = _norm(jnp.cross(T_prev, T_next))
-    return sin, jnp.sum(T_prev * T_next, axis=-1)
+        sin = _norm(xp.cross(T_prev, T_next))
+    return sin, xp.sum(T_prev * T_next, axis=-1)
 
 
 def _half_angle_tangents(gamma: Array, closed: bool) -> Array:
@@ -322,31 +323,33 @@ def turning_angles(gamma: Curve, closed: bool = False) -> Float[Array, " m"]:
     **Returns:** (N − 2,) for an open curve (entry j at vertex j + 1), (N,) for a closed one.
     **Raises:** as `tangents`.
     """
-    return jnp.arctan2(*_sin_cos(_validate(gamma, closed), closed))
+    return _turning_angles(_validate(gamma, closed), closed)
 
 
 @_jit
+def _turning_angles(gamma: Array, closed: bool) -> Array:
+    return jnp.arctan2(*_sin_cos(gamma, closed))
+
+
 def _vertex_curvature(gamma: Array, closed: bool) -> Array:
     """Def 1.4: `κ_k = 2 sin φ_k / |γ_{k+1} − γ_{k−1}|`, the inverse radius of the circle through
     γ_{k−1}, γ_k, γ_{k+1}.  Equals 2 sin(φ_k/2) ≤ 2 for unit edges (Remark 1.4)."""
     sin, _ = _sin_cos(gamma, closed)
     gamma, s = normalised(gamma)
-    E_prev, E_next = _vertex_pairs(_edges(gamma, closed), closed)
+    E_prev, E_next = _vertex_pairs(_edges_of(gamma, closed), closed)
     return 2 * sin / _norm(E_prev + E_next) / s
 
 
-@_jit
 def _edge_curvature(gamma: Array, closed: bool) -> Array:
     """Def 1.5: `κ_k = (tan(φ_k/2) + tan(φ_{k+1}/2)) / |Δγ_k|` at edge k, the inverse radius of
     the oriented circle touching the lines of the edges k − 1, k, k + 1."""
     half = _half_angle_tangents(gamma, closed)
     lengths, s = _normalised_lengths(gamma, closed)
     if closed:
-        return (half + jnp.roll(half, -1)) / lengths / s
+        return (half + namespace(half).roll(half, -1)) / lengths / s
     return (half[:-1] + half[1:]) / lengths[1:-1] / s
 
 
-@_jit
 def _arclength_curvature(gamma: Array, closed: bool) -> Array:
     """Def 1.6, (1.1): `κ_k = 2 tan(φ_k/2) / ε`, the inverse radius of the circle touching the
     edges k − 1 and k at their midpoints (ε = 1 gives (1.1)); ε is the mean of the two lengths."""
@@ -376,10 +379,11 @@ def _checked_arclength(gamma, closed: bool) -> Array:
 
 
 _CURVATURES = {
-    "vertex": (_checked_vertex, _vertex_curvature),
-    "edge": (_checked_edge, _edge_curvature),
-    "arclength": (_checked_arclength, _arclength_curvature),
+    "vertex": (_checked_vertex, _vertex_curvature, _jit(_vertex_curvature)),
+    "edge": (_checked_edge, _edge_curvature, _jit(_edge_curvature)),
+    "arclength": (_checked_arclength, _arclength_curvature, _jit(_arclength_curvature)),
 }
+"""Per kind: the input's checks, the formula (NumPy or traced) and its compiled call."""
 
 
 def curvature(gamma: Curve, kind: str, closed: bool = False) -> Float[Array, " m"]:
@@ -404,8 +408,11 @@ def curvature(gamma: Curve, kind: str, closed: bool = False) -> Float[Array, " m
     """
     if kind not in _CURVATURES:
         raise InvalidInputError(f"curvature kind must be one of {tuple(_CURVATURES)}, got {kind!r}")
-    checked, formula = _CURVATURES[kind]
-    return formula(checked(gamma, closed), closed)
+    checked, formula, compiled = _CURVATURES[kind]
+    gamma = checked(gamma, closed)
+    if is_concrete(gamma):  # the formula in NumPy: no program compiled per number of vertices
+        return on_device(formula(np.asarray(gamma), closed))
+    return compiled(gamma, closed)
 
 
 # ---------------------------------------------------------------------------------------------

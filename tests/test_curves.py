@@ -305,3 +305,22 @@ def test_plots_draw_the_polylines(tmp_path, rng):
     assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == ["a", "b", "c"]
     path = dg.plot.curve(gamma, path=tmp_path / "space.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_curvatures_of_concrete_curves_are_computed_in_numpy_like_traced_ones():
+    """Defs 1.4–1.6 on concrete curves run the formulas in NumPy (no program compiled for each
+    number of vertices: the compiled calls' caches do not grow over 5 sizes) and agree to
+    round-off with the same formulas traced under `jit`."""
+    compiled = {kind: entry[2] for kind, entry in curves._CURVATURES.items()}
+    cases = []
+    for n in (9, 17, 33, 65, 129):
+        t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+        planar = np.stack([np.cos(t), 2.0 * np.sin(t)], axis=1)
+        unit = np.cumsum(np.stack([np.cos(0.3 * np.sin(t)), np.sin(0.3 * np.sin(t))], axis=1), axis=0)
+        cases += [("vertex", planar, True), ("vertex", planar, False), ("edge", planar, True),
+                  ("edge", planar, False), ("arclength", unit, False)]
+    before = {kind: fn._cache_size() for kind, fn in compiled.items()}
+    values = [curves.curvature(gamma, kind, closed) for kind, gamma, closed in cases]
+    assert {kind: fn._cache_size() for kind, fn in compiled.items()} == before
+    for (kind, gamma, closed), value in zip(cases, values):
+        assert np.max(np.abs(np.asarray(value) - np.asarray(compiled[kind](jnp.asarray(gamma), closed)))) < 1e-13
