@@ -328,6 +328,7 @@ def turning_angles(gamma: Curve, closed: bool = False) -> Float[Array, " m"]:
 
 @_jit
 def _turning_angles(gamma: Array, closed: bool) -> Array:
+    """φ_k = atan2(sin φ_k, cos φ_k), compiled."""
     return jnp.arctan2(*_sin_cos(gamma, closed))
 
 

@@ -121,7 +121,7 @@ class Problem:
         shapes and dtypes are those of the fields they replace: the energy's and constraints'
         output shapes, which the declaration's checks trace the functions to find, are the same
         (a continuation or a parameter sweep makes one problem per point)."""
-        other = object.__new__(Problem)
+        other = object.__new__(type(self))
         other.__dict__.update(self.__dict__)
         other.__dict__.update(checked)
         return other

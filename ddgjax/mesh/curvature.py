@@ -194,7 +194,8 @@ def angle_defect(V, F):
     """
     h = _validate(V, F)
     if h is not None and _is_triangle_array(F) and is_concrete(V):  # in NumPy, the angles in blocks
-        return angle_defects(h, np.sqrt(squared_side_lengths(normalised(np.asarray(V, dtype=float))[0][np.asarray(F)])))
+        P = normalised(np.asarray(V, dtype=float))[0][np.asarray(F)]
+        return angle_defects(h, np.sqrt(squared_side_lengths(P)))
     vertex, nxt, prv = _corners(F)
     nv = jnp.shape(V)[0]
     boundary = _boundary_vertices(vertex, nxt, nv) if h is None else h.boundary_vertex_mask

@@ -330,6 +330,7 @@ def _blockwise(kernel, X: np.ndarray, n: int, axis: int):
     width = X.shape[axis]
     block = min(width, TRIANGLE_BLOCKS[-1])
     cut = (lambda a: a[:n]) if axis == 0 else (lambda a: a[..., :n])
+
     def run(start: int):
         part = X[start : start + block] if axis == 0 else X[:, start : start + block]
         return jax.tree_util.tree_map(np.asarray, kernel(np.ascontiguousarray(part)))
