@@ -171,7 +171,7 @@ def test_jit_matches_eager():
 
 
 def test_concrete_and_traced_angle_defects_agree():
-    """Def 5.2 / Remark 5.4 two ways: concrete triangle meshes in NumPy (corner angles in blocks,
+    """Def 5.2 / Remark 5.4 (and the corner angles) two ways: concrete triangle meshes in NumPy (corner angles in blocks,
     sums per vertex by `bincount`), traced ones in one jitted kernel; the same numbers to
     round-off on closed meshes of genus 0 and 1 and on a disk (boundary vertices: π − Σ α)."""
     for V, F in (mesh.icosphere(2), mesh.torus(12, 6), mesh.builtin.disk(4, 12)):
@@ -179,3 +179,6 @@ def test_concrete_and_traced_angle_defects_agree():
         traced = jax.jit(lambda X, F=F: mesh.angle_defect(X, jnp.asarray(F)))(jnp.asarray(V))
         assert isinstance(concrete, np.ndarray) and concrete.shape == (len(V),)
         assert np.max(np.abs(concrete - np.asarray(traced))) < 1e-14
+        angles = mesh.corner_angles(V, F)  # the corner angles they sum, the same two ways
+        traced_angles = jax.jit(lambda X, F=F: mesh.corner_angles(X, jnp.asarray(F)))(jnp.asarray(V))
+        assert angles.shape == np.shape(F) and np.max(np.abs(angles - np.asarray(traced_angles))) < 1e-14

@@ -35,6 +35,7 @@ from .lengths import check_positions
 from .lengths import (
     angle_defects,
     check_face_areas,
+    corner_angles_of_sides,
     defect_from_angles,
     normalised,
     scaled_back,
@@ -162,9 +163,22 @@ def corner_angles(V, F):
     **Returns:** (nf, k) for an (nf, k) array `F`, else (n_corners,) in the order of the faces.
     **Raises:** as `angle_defect`; scale-invariant (module docstring).
     """
-    _validate(V, F)
+    h = _validate(V, F)
+    L = _concrete_side_lengths(V, F, h)
+    if L is not None:
+        return corner_angles_of_sides(L)
     angles = _angles_at_corners(namespace(V).asarray(V), *_corners(F), triangles=_is_triangle_array(F))
     return angles.reshape(jnp.shape(F)) if hasattr(F, "shape") else angles
+
+
+def _concrete_side_lengths(V, F, h) -> np.ndarray | None:
+    """(nf, 3) side lengths of V / s (`normalised`; L[f, k] opposite corner k) in NumPy for a
+    concrete V and a concrete (nf, 3) `F` (checked: `h`), whose angles are then computed in
+    blocks (`lengths.corner_angles_of_sides`) rather than by a kernel compiled per mesh; None
+    otherwise."""
+    if h is None or not _is_triangle_array(F) or not is_concrete(V):
+        return None
+    return np.sqrt(squared_side_lengths(normalised(np.asarray(V, dtype=float))[0][np.asarray(F)]))
 
 
 def _boundary_vertices(vertex, nxt, nv):
@@ -193,9 +207,9 @@ def angle_defect(V, F):
     coincide.
     """
     h = _validate(V, F)
-    if h is not None and _is_triangle_array(F) and is_concrete(V):  # in NumPy, the angles in blocks
-        P = normalised(np.asarray(V, dtype=float))[0][np.asarray(F)]
-        return angle_defects(h, np.sqrt(squared_side_lengths(P)))
+    L = _concrete_side_lengths(V, F, h)
+    if L is not None:
+        return angle_defects(h, L)
     vertex, nxt, prv = _corners(F)
     nv = jnp.shape(V)[0]
     boundary = _boundary_vertices(vertex, nxt, nv) if h is None else h.boundary_vertex_mask
