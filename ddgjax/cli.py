@@ -527,7 +527,7 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("--list", action="store_true", help="list the checks and exit")
     verify.add_argument("--no-progress", action="store_true", help="no progress bar")
     verify.add_argument("--jobs", type=_positive_int, default=min(2, os.cpu_count() or 1),
-                        help="processes that run checks, this one included (default: 2, or 1 on a single core)")
+                        help="worker processes (default: 2, or 1 on a single core)")
     verify.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                         help="stop at the first failing check with its traceback")
     verify.set_defaults(run=_verify)
@@ -597,21 +597,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _end_process(code: int) -> None:
-    """End the `ddgjax verify` process now, with exit code `code`, skipping JAX's teardown of the
-    compiled programs it holds (seconds: this process runs checks too): the report is written
-    and closed, the worker processes are stopped, only the output streams are left to flush."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (also used by the `ddgjax` entry point).
 
     A `DDGError` or an `OSError` (a path that cannot be read or written) is one line on stderr
-    and exit code 2, or its traceback with `--debug`.  Called without `argv` (the `ddgjax`
-    command), `verify` ends its process when done (`_end_process`).
+    and exit code 2, or its traceback with `--debug`.
     """
     args = None
     try:
@@ -619,10 +609,7 @@ def main(argv: list[str] | None = None) -> int:
         args.argv = list(sys.argv[1:] if argv is None else argv)
         if args.command in ("solve", "sweep", "verify"):  # not for `bench`, which measures compile times
             compile_cache.enable()
-        code = args.run(args)
-        if argv is None and args.command == "verify":
-            _end_process(code)
-        return code
+        return args.run(args)
     except (DDGError, OSError) as error:
         if getattr(args, "debug", False):
             raise

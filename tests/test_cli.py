@@ -1,7 +1,6 @@
 """The `ddgjax` command line: one-line errors with a hint and exit code 2, the verify report
 (table, convergence tables, figures present), a failing check gives a non-zero exit."""
 
-import os
 import re
 import subprocess
 import sys
@@ -194,38 +193,3 @@ def test_quick_verify_passes_every_check(tmp_path):
     outcomes, report = verify.verify(tmp_path, quick=True, jobs=2)
     assert [o.check.name for o in outcomes if not o.passed] == []
     assert all(p.is_file() for p in _referenced_figures(report))
-
-
-def test_verify_jobs_share_the_groups_of_checks_between_this_process_and_its_workers(tmp_path, monkeypatch):
-    """`jobs=2`: this process and one spawned worker each take the next group of checks no other
-    has taken: every check runs exactly once, both processes run some (the worker starts while
-    this process loads the checks, so this one begins first), and the outcomes keep the order
-    of the checks."""
-    package = tmp_path / "jobs_probe"
-    package.mkdir()
-    log = tmp_path / "ran"
-    log.mkdir()
-    for k in range(6):  # six modules: six groups, each check long enough for the worker to start
-        (package / f"group_{k}.py").write_text(
-            "import os, time\nfrom pathlib import Path\nfrom ddgjax.verify import check\n"
-            f"@check('Test {k}', 'group {k} runs once', quantity='0', at_most=0.0, name='jobs_probe_{k}')\n"
-            f"def jobs_probe_{k}(ctx):\n"
-            f"    time.sleep(1.0)\n"
-            f"    (Path({str(log)!r}) / 'jobs_probe_{k}.{{}}'.format(os.getpid())).touch()\n"
-            f"    return 0.0\n")
-    monkeypatch.syspath_prepend(str(tmp_path))  # spawned workers get this process's sys.path
-    import importlib
-
-    names = [f"jobs_probe_{k}" for k in range(6)]
-    try:
-        for k in range(6):
-            importlib.import_module(f"jobs_probe.group_{k}")
-        outcomes = verify.run([verify.registry[n] for n in names], tmp_path / "out", quick=True, jobs=2)
-    finally:
-        for n in names:
-            verify.registry.pop(n, None)
-    assert [o.check.name for o in outcomes] == names and all(o.passed for o in outcomes)
-    ran = sorted(p.name for p in log.iterdir())
-    assert sorted(r.split(".")[0] for r in ran) == names  # each exactly once
-    pids = {int(r.split(".")[1]) for r in ran}
-    assert os.getpid() in pids and len(pids) == 2

@@ -94,47 +94,26 @@ def _group(c: Check) -> str:
 _PROGRESS = None
 """In a worker process: the queue its outcomes' status lines go to (`_started_worker`)."""
 
-_NEXT = None
-"""In every process of a parallel run: the shared index of the next unclaimed task (`_claim`)."""
 
-
-def _started_worker(progress, next_task) -> None:
-    """A worker's initialiser: keep the progress queue and the shared task index (handed to a
+def _started_worker(progress) -> None:
+    """A worker's initialiser: keep the progress queue (a multiprocessing queue is handed to a
     process when it starts, not with each task)."""
-    global _PROGRESS, _NEXT
-    _PROGRESS, _NEXT = progress, next_task
+    global _PROGRESS
+    _PROGRESS = progress
 
 
-def _claim() -> int:
-    """The index of the next task no process has taken yet (and take it)."""
-    with _NEXT.get_lock():
-        index = _NEXT.value
-        _NEXT.value = index + 1
-    return index
-
-
-def _run_names(modules: list[str], names: list[str], out: str, quick: bool, report) -> list[dict]:
-    """Import `modules`, run the checks `names` (`report(status line)` after each), return plain data."""
+def _run_names(modules: list[str], names: list[str], out: str, quick: bool) -> list[dict]:
+    """Worker of the parallel run: import `modules`, run the checks `names`, return plain data."""
     for module in modules:
         importlib.import_module(module)
     results = []
     for name in names:
         outcome = run_check(registry[name], Path(out), quick)
-        report(_status(outcome))
+        if _PROGRESS is not None:
+            _PROGRESS.put(_status(outcome))
         results.append({k: getattr(outcome, k) for k in ("value", "passed", "seconds", "sizes", "figures", "tables",
                                                          "error", "skipped")} | {"name": name})
     return results
-
-
-def _drain(tasks: list[tuple[list[str], list[str]]], out: str, quick: bool, report=None) -> dict[int, list[dict]]:
-    """Run the tasks `(modules, check names)` that no other process has claimed, one after the
-    other, until none is left; returns `{task index: rows}`.  In a worker the status lines go to
-    the progress queue, in the calling process to `report`."""
-    report = report or _PROGRESS.put
-    done = {}
-    while (index := _claim()) < len(tasks):
-        done[index] = _run_names(*tasks[index], out, quick, report)
-    return done
 
 
 def _warm_up() -> None:
@@ -144,10 +123,9 @@ def _warm_up() -> None:
 
 @contextmanager
 def _workers(jobs: int):
-    """`(pool, queue, count)`: `count = jobs − 1` spawned worker processes, started at once (they
-    import JAX and the library while the caller loads the checks; the caller is the last of the
-    `jobs` processes that run checks), and a queue for their progress; `None` if `jobs` ≤ 1."""
-    global _NEXT
+    """`(pool, queue)`: `jobs` spawned worker processes, started at once (they import JAX and the
+    library while the caller loads the checks), and a queue for their progress; `None` if
+    `jobs` ≤ 1."""
     if jobs <= 1:
         yield None
         return
@@ -156,15 +134,15 @@ def _workers(jobs: int):
 
     # The checks solve small problems once each: XLA's compile time, not their run time, is
     # most of a run.  Spawned workers start a fresh JAX backend, so the fast-compile flags apply
-    # there, and in this process if its backend has not started yet (unless XLA_FLAGS is set).
+    # there (unless XLA_FLAGS is set already).
     os.environ.setdefault("XLA_FLAGS", compile_cache.fast_compile_xla_flags())
     context = multiprocessing.get_context("spawn")
-    progress, _NEXT = context.Queue(), context.Value("i", 0)
-    pool = ProcessPoolExecutor(jobs - 1, mp_context=context, initializer=_started_worker, initargs=(progress, _NEXT))
+    progress = context.Queue()
+    pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=_started_worker, initargs=(progress,))
     try:
-        for _ in range(jobs - 1):
+        for _ in range(jobs):
             pool.submit(_warm_up)
-        yield pool, progress, jobs - 1
+        yield pool, progress
     finally:
         # idle now (or after an error): stop the workers instead of waiting for their JAX to
         # shut down, seconds with thousands of compiled programs (no public API for this)
@@ -176,63 +154,41 @@ def _workers(jobs: int):
             process.join(timeout=10)
         pool.shutdown(wait=True)  # the pool's thread sees its workers gone and ends before the interpreter does
         progress.close()
-        _NEXT = None
 
 
 def _run_parallel(checks: list[Check], out, quick: bool, workers, advance) -> list[Outcome]:
-    """Run groups of checks in this process and on the workers `(pool, queue, count)` of `_workers` (JIT
-    compilation is single-threaded, so two cores compile two problems at once): each process
-    takes the next group no other has taken, the longest groups first; returns outcomes in the
-    order of `checks`."""
-    pool, queue, count = workers
+    """Run groups of checks on the `(pool, queue)` of `_workers` (JIT compilation is
+    single-threaded, so two cores compile two problems at once), the longest groups first;
+    returns outcomes in the order of `checks`."""
+    pool, queue = workers
     groups: dict[str, list[Check]] = {}
     for c in checks:
         groups.setdefault(_group(c), []).append(c)
-    groups_in_order = sorted(groups.values(), key=len, reverse=True)
-    tasks = [(sorted({c.fn.__module__ for c in group}), [c.name for c in group]) for group in groups_in_order]
-    with _NEXT.get_lock():
-        _NEXT.value = 0
-    futures = [pool.submit(_drain, tasks, str(out), quick) for _ in range(count)]
-
-    def progressed(block: bool = False) -> None:
-        """Advance the bar by the workers' status lines that have arrived (waiting for one if `block`)."""
-        while True:
-            try:
-                advance(queue.get(timeout=0.5) if block else queue.get_nowait())
-            except Empty:
-                return
-            block = False
-
-    def report(line: str) -> None:
-        advance(line)
-        progressed()
-
-    done = _drain(tasks, str(out), quick, report)
-    while not all(f.done() for f in futures):
-        progressed(block=True)
-    for future in futures:
-        done |= _rows_of(future)
-    progressed()
+    tasks = sorted(groups.values(), key=len, reverse=True)
+    futures = [pool.submit(_run_names, sorted({c.fn.__module__ for c in task}), [c.name for c in task], str(out),
+                           quick) for task in tasks]
+    received = 0  # status lines: one per check, unless its worker died
+    while received < len(checks):
+        try:
+            advance(queue.get(timeout=0.5))
+            received += 1
+        except Empty:
+            if all(f.done() for f in futures):  # and nothing arrived for 0.5 s: a worker failed
+                break
     results = {}
-    for index, group in enumerate(groups_in_order):
-        rows = done.get(index) or _failed_rows(group, quick, "its worker process failed")
-        for c, row in zip(group, rows, strict=True):
+    for task, future in zip(tasks, futures, strict=True):
+        for c, row in zip(task, _rows(task, future, quick), strict=True):
             results[c.name] = row
     return [Outcome(c, **{k: v for k, v in results[c.name].items() if k != "name"}) for c in checks]
 
 
-def _rows_of(future) -> dict[int, list[dict]]:
-    """A worker's `{task index: rows}`, or nothing if the worker itself failed (e.g. killed for
-    memory): its unfinished tasks are then reported failed, not waited for."""
+def _rows(task: list[Check], future, quick: bool) -> list[dict]:
+    """The worker's results, or one failed row per check if the worker itself failed."""
     try:
         return future.result()
-    except Exception:
-        return {}
-
-
-def _failed_rows(task: list[Check], quick: bool, why: str) -> list[dict]:
-    return [dict(name=c.name, value=float("nan"), passed=False, seconds=0.0, sizes=c.sizes(quick), figures=[],
-                 tables=[], error=why, skipped=False) for c in task]
+    except Exception as exc:  # e.g. a worker killed for memory: report, do not hang or crash
+        return [dict(name=c.name, value=float("nan"), passed=False, seconds=0.0, sizes=c.sizes(quick), figures=[],
+                     tables=[], error=f"worker failed: {one_line(exc)}", skipped=False) for c in task]
 
 
 def run(checks: list[Check], out, *, quick: bool, progress: bool = False, debug: bool = False,
