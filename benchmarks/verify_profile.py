@@ -35,10 +35,9 @@ from ddgjax import compile_cache
 EVENTS = {
     "/jax/core/compile/jaxpr_trace_duration": "trace",
     "/jax/core/compile/jaxpr_to_mlir_module_duration": "lower",
-    "/jax/core/compile/backend_compile_duration": "xla",
 }
-"""`jax.monitoring` duration events and the column each adds to (`xla` is split into `load` and
-`compile` by the log of the compilation cache)."""
+"""`jax.monitoring` duration events and their columns; `load` and `compile` come from JAX's log
+(a cache hit, then XLA's "compilation", which is then the load of the cached executable)."""
 
 COMPILED = re.compile(r"Finished XLA compilation of (\S+) in ([0-9.e-]+) sec")
 HIT = re.compile(r"Persistent compilation cache hit for '(\S+)'")
@@ -116,7 +115,6 @@ def main() -> None:
         compiled = sum(s for _, s in recorder.compiled)
         for name, s in recorder.compiled:
             uncached[name] += s
-        # the `xla` event times the cache read and the compilation alike; `load` and `compile` come from the log
         parts = {"trace": recorder.seconds["trace"], "lower": recorder.seconds["lower"], "load": load,
                  "solvers": solvers, "compile": compiled}
         other = wall - parts["trace"] - parts["lower"] - load - compiled
