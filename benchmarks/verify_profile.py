@@ -15,8 +15,9 @@ parts add up: the parallel run spreads the same work over its processes.  Per ch
     ddgjax verify --quick --no-progress --out /tmp/warm     # once, to fill the caches
     python benchmarks/verify_profile.py [--top 15] [WORD ...]
 
-WORD selects checks as `ddgjax verify --only` does.  The machine may be shared: compare runs
-made one after the other only.
+WORD selects checks as `ddgjax verify --only` does; `--quick` (as `ddgjax bench --quick` passes
+it) profiles only `QUICK`, the two groups that show each kind of cost (~20 s).  The machine may
+be shared: compare runs made one after the other only.
 """
 
 from __future__ import annotations
@@ -38,6 +39,10 @@ EVENTS = {
 }
 """`jax.monitoring` duration events and their columns; `load` and `compile` come from JAX's log
 (a cache hit, then XLA's "compilation", which is then the load of the cached executable)."""
+
+QUICK = ("sec3_rod_limits", "ext_bubbles")
+"""The checks of `--quick`: rods (the largest exported solvers) and bubbles (Pardiso's uncached
+solvers, a stalled Newton solve)."""
 
 COMPILED = re.compile(r"Finished XLA compilation of (\S+) in ([0-9.e-]+) sec")
 HIT = re.compile(r"Persistent compilation cache hit for '(\S+)'")
@@ -93,7 +98,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("only", nargs="*", metavar="WORD")
     parser.add_argument("--top", type=int, default=15, help="checks listed, the slowest first")
+    parser.add_argument("--quick", action="store_true", help=f"only the checks of {' and '.join(QUICK)}")
     args = parser.parse_args()
+    words = list(QUICK) if args.quick and not args.only else args.only
     os.environ.setdefault("XLA_FLAGS", compile_cache.fast_compile_xla_flags())  # as verify's workers
     compile_cache.enable()
     recorder = install()
@@ -105,7 +112,7 @@ def main() -> None:
     rows, uncached = [], collections.Counter()
     out = Path(tempfile.mkdtemp(prefix="verify_profile_"))
     start = time.perf_counter()
-    for check in select(args.only or None):
+    for check in select(words or None):
         recorder.reset()
         began = time.perf_counter()
         outcome = run_check(check, out, True)
