@@ -63,30 +63,46 @@ class SmoothRod(NamedTuple):
     length: float
 
 
-def _field(s, y, args):
+def _field(sigma, y, args):
+    """The top's vector field with γ' = T (Thm 3.11), times `gap`: the motion over an arc length
+    `gap` as a function of σ ∈ [0, 1] (s = s₀ + gap·σ)."""
     Phi, M, _gamma = y
-    alpha, a = args
+    alpha, a, gap = args
     d = equations_of_motion(TopState(Phi, M), alpha, a)
-    return d.Phi, d.M, qt.rotate(Phi, E1)
+    return gap * d.Phi, gap * d.M, gap * qt.rotate(Phi, E1)
 
 
-def _integrate(Phi0, M0, a, alpha, length, ts):
-    """(Φ, M, γ) of the top motion at the arc lengths ts (γ(0) = 0)."""
+def _flow(y, gap, alpha, a):
+    """The state (Φ, M, γ) of the top motion an arc length `gap` ≥ 0 after the state y: one
+    diffrax solve of `_field` over the unit interval.  Its bounds and first step are constants,
+    so diffrax checks them when tracing, not with host callbacks in the program (which would
+    keep it out of the persistent compilation cache)."""
     sol = diffrax.diffeqsolve(
         diffrax.ODETerm(_field),
         diffrax.Dopri8(),
         t0=0.0,
-        t1=length,
-        dt0=length / 64,
-        y0=(Phi0, M0, jnp.zeros(3)),
-        args=(alpha, a),
-        saveat=diffrax.SaveAt(ts=ts),
+        t1=1.0,
+        dt0=0.25,
+        y0=y,
+        args=(alpha, a, gap),
+        saveat=diffrax.SaveAt(t1=True),
         stepsize_controller=diffrax.PIDController(rtol=RTOL, atol=RTOL),
         adjoint=diffrax.ForwardMode(),
         max_steps=100_000,
         throw=False,  # a diverging Newton iterate gives inf/NaN, caught by the final residual check
     )
-    return sol.ys
+    return jax.tree_util.tree_map(lambda v: v[0], sol.ys)
+
+
+def _integrate(Phi0, M0, a, alpha, ts):
+    """(Φ, M, γ) of the top motion at the arc lengths ts (non-decreasing, ≥ 0; γ(0) = 0): the
+    flow from each arc length to the next (`lax.scan` of `_flow`)."""
+    def step(y, gap):
+        y = _flow(y, gap, alpha, a)
+        return y, y
+
+    gaps = jnp.diff(ts, prepend=jnp.zeros(1, ts.dtype))
+    return jax.lax.scan(step, (Phi0, M0, jnp.zeros(3, M0.dtype)), gaps)[1]
 
 
 _integrate_jit = jax.jit(_integrate)
@@ -109,7 +125,7 @@ def _sample(rod: SmoothRod, s) -> tuple:
         raise InvalidInputError(f"arc lengths must be non-decreasing: s[{k + 1}] = {float(s[k + 1])!r} < s[{k}] = "
                                 f"{float(s[k])!r}")
     padded = xp.concatenate([s, xp.full((-m % SAMPLE_BUCKET,), s[-1])]) if m else s
-    ys = _integrate_jit(rod.Phi0, rod.M0, rod.a, rod.alpha, rod.length, padded)
+    ys = _integrate_jit(rod.Phi0, rod.M0, rod.a, rod.alpha, padded)
     return _first_rows(ys, m)
 
 
@@ -121,7 +137,7 @@ def _first_rows(ys: tuple, m: int) -> tuple:
 
 def shoot(z: Float[Array, "6"], Phi0, Phi1, chord, alpha, length) -> Float[Array, "6"]:
     """The shooting residual of z = (M0, a): `(Im(Φ1⁻¹ Φ(L)), γ(L) − chord)`."""
-    Phi, _M, gamma = _integrate(Phi0, z[:3], z[3:], alpha, length, jnp.array([length]))
+    Phi, _M, gamma = _integrate(Phi0, z[:3], z[3:], alpha, jnp.reshape(length, (1,)))
     return jnp.concatenate([qt.mul(qt.conj(Phi1), Phi[0])[1:], gamma[0] - chord])
 
 
