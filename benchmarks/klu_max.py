@@ -23,21 +23,20 @@ Problems (`energies.area`):
 
     python benchmarks/klu_max.py [--repeats 3] [--problems "bubble 3" ...]
 
-Measured 2026-12-07 on the shared 2-core machine (load 1.3; N of the saddles counted with the
-fixed border then, so 675 / 1200 / 2700 there are n + m = 507 / 972 / 2352):
+Measured on the shared 2-core machine, one process per row after a warming one (`--repeats 1`,
+load 1.1; a machine about 2× slower than that of the earlier table kept in git history):
 
     problem                 N | KLU first   solve steps | SD first   solve steps | first SD/KLU solve SD/KLU
-    bubble 2              487 |      0.42   0.027     6 |     3.34   0.014     4 |         7.93         0.51
-    saddle 15             675 |      0.25   0.008     4 |     2.40   0.015     4 |         9.45         1.80
-    double bubble 24     1019 |      2.46   1.637     0 |     4.50   0.532    34 |         1.83         0.32
-    saddle 20            1200 |      0.30   0.020     4 |     2.17   0.022     4 |         7.20         1.13
-    bubble 3             1927 |      0.49   0.114     5 |     3.50   0.077     5 |         7.13         0.67
-    saddle 30            2700 |      0.40   0.052     4 |     2.48   0.042     4 |         6.14         0.80
-    bubble 4             7687 |      2.74   2.244    10 |     3.46   0.407    10 |         1.26         0.18
+    bubble 2              487 |      0.54   0.026     4 |     6.37   0.029     4 |        11.86         1.13
+    saddle 15             507 |      0.41   0.015     4 |     4.21   0.026     4 |        10.14         1.78
+    double bubble 24     1019 |      1.08   0.472    35 |     6.18   0.309    13 |         5.74         0.66
+    saddle 20             972 |      0.53   0.025     4 |     3.91   0.035     4 |         7.34         1.38
+    bubble 3             1927 |      0.95   0.326     8 |     6.29   0.076     5 |         6.62         0.23
+    saddle 30            2352 |      0.41   0.065     4 |     4.52   0.059     4 |        10.97         0.91
+    bubble 4             7687 |      6.08   4.734    11 |     7.97   1.311    10 |         1.31         0.28
 
-At the tolerance of verify's bubbles (tol 1e-12) KLU meets the rigid motions of a closed surface
-(a nearly singular KKT matrix) worse than Pardiso's pivoting: bubble 3 takes 45 Newton steps with
-KLU and 7 with Pardiso (1.7 vs 0.3 s once compiled); `solvers._solve.KLU_MAX` is 1000.
+At verify's tolerance for bubbles (tol 1e-12) bubble 3 takes 9 Newton steps with KLU and 8 with
+Pardiso (earlier Newton iterations took 45 with KLU there); `solvers._solve.KLU_MAX` is 2500.
 
 The machine may be shared: compare rows of one run only.
 """

@@ -87,16 +87,16 @@ def is_chain(problem: Problem, spec: Spec) -> bool:
     return derived(pattern, "chain", lambda: chain_structure(pattern, spec.layout.free, width)) is not None
 
 
-KLU_MAX = 1000
+KLU_MAX = 2500
 """Unknowns + multipliers up to which `method="sparse"` takes KLU on meshes too.  KLU's Newton
 solvers are kept on disk (`_exported`); `SparseDirect`'s host callbacks are not, so every new
 process traces and compiles them again.  Measured by `python benchmarks/klu_max.py` (the time to
-a first solution in a new process with warm caches, KLU vs Pardiso): 0.25–0.5 s vs 2.2–3.5 s on
-surfaces of N = 487–2,352, where a solve once compiled takes 0.6–1.8 × Pardiso's time.  Above
-N ≈ 1,000 Pardiso's pivoting is worth its compilation on closed surfaces, whose KKT matrix
-the rigid motions make nearly singular: the bubble of N = 1,927 at tol 1e-12 takes 45 Newton
-steps with KLU and 7 with Pardiso (1.7 vs 0.3 s once compiled), the double bubble of N = 1,019
-stalls with KLU."""
+a first solution in a new process with warm caches, KLU vs Pardiso, one run): 0.4–1.1 s vs
+3.9–6.4 s on surfaces of N = 487–2,352 (5.7–11× faster), where a solve once compiled takes
+0.6–4.3× Pardiso's time (closed surfaces: 1.5× on the double bubble of N = 1,019, 4.3× = 0.25 s
+more on the bubble of N = 1,927: KLU is ahead for the first ~20 solves in a process).  At
+N = 7,687 (bubble 4) Pardiso's fill-reducing factorisation wins outright (1.3 vs 4.7 s per
+solve).  Newton's steps are alike on both (the bubble of N = 1,927 at tol 1e-12: 9 vs 8)."""
 
 
 def sparse_direct_for(problem: Problem, spec: Spec) -> LinearSolver:
