@@ -79,3 +79,52 @@ def test_sampling_a_smooth_rod_at_decreasing_arc_lengths_is_an_input_error():
                                0.6, 1.0)
     with pytest.raises(InvalidInputError, match=r"s\[2\] = 0.1"):
         kirchhoff.sample(rod_, jnp.array([0.0, 0.5, 0.1]))
+
+
+HOST_CALLBACK = "python_cpu_callback"  # the custom call of jax.pure_callback / diffrax's error_if on the CPU
+
+
+def _top_motion():
+    """The top motion of verify's quick rod limits (Thm 3.11: a smooth rod)."""
+    return kirchhoff.SmoothRod(jnp.array([1.0, 0, 0, 0]), jnp.array([2.4, 3.0, -1.0]), jnp.array([16.2, 15.9, 1.0]),
+                               0.6, 1.0)
+
+
+def test_sampling_the_smooth_rod_compiles_without_host_callbacks():
+    """Sampling and the shooting residual are programs without host callbacks, which JAX keeps in
+    its persistent compilation cache (a program with one is compiled in every process).
+    Negative control: diffrax with a traced end time inserts one (its input check)."""
+    import diffrax
+    import jax
+
+    rod_ = _top_motion()
+    s = jnp.linspace(0.0, 1.0, kirchhoff.SAMPLE_BUCKET)
+    sampling = kirchhoff._integrate_jit.lower(rod_.Phi0, rod_.M0, rod_.a, rod_.alpha, s).as_text()
+    shooting = kirchhoff._shoot.lower(jnp.zeros(6), rod_.Phi0, rod_.Phi0, CHORD, 0.6, 1.0).as_text()
+    assert HOST_CALLBACK not in sampling and HOST_CALLBACK not in shooting
+
+    def decay(t1):
+        return diffrax.diffeqsolve(diffrax.ODETerm(lambda t, y, args: -y), diffrax.Tsit5(), 0.0, t1, 0.1,
+                                   jnp.ones(2), throw=False).ys
+    assert HOST_CALLBACK in jax.jit(decay).lower(1.0).as_text()
+
+
+def test_sampling_gap_by_gap_equals_one_integration_saving_at_every_arc_length():
+    """The top motion integrated from one sampled arc length to the next (`kirchhoff._flow`)
+    equals one diffrax solve over [0, L] saving at the same arc lengths, to the integrators'
+    tolerance (1e-13 relative): the two differ only in where the step-size control restarts."""
+    import diffrax
+
+    rod_ = _top_motion()
+    s = np.concatenate([[0.0], (np.arange(32) + 0.5) / 32, [1.0]])
+    Phi, gamma = kirchhoff.sample(rod_, s)
+
+    def field(t, y, args):
+        return kirchhoff._field(t, y, (rod_.alpha, rod_.a, 1.0))
+
+    once = diffrax.diffeqsolve(
+        diffrax.ODETerm(field), diffrax.Dopri8(), t0=0.0, t1=1.0, dt0=1.0 / 64, y0=(rod_.Phi0, rod_.M0, jnp.zeros(3)),
+        saveat=diffrax.SaveAt(ts=jnp.asarray(s)),
+        stepsize_controller=diffrax.PIDController(rtol=kirchhoff.RTOL, atol=kirchhoff.RTOL), max_steps=100_000)
+    assert np.max(np.abs(np.asarray(Phi) - np.asarray(once.ys[0]))) <= 1e-10
+    assert np.max(np.abs(np.asarray(gamma) - np.asarray(once.ys[2]))) <= 1e-10
