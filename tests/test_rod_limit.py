@@ -5,6 +5,8 @@ computed as a motion of the Lagrange top (Kirchhoff analogy, Thm 3.11) by shooti
 (`ddgjax.kirchhoff`); the discrete rod only supplies the starting guess.  The quick limits
 (Thm 3.11, 3.13 and the coefficient c of Def 3.7, at n = 8, 16, 32, with a negative control)
 are checks of `ddgjax verify` (`sec3_rod_limits`), which `tests/test_verify_checks.py` runs.
+The last two tests (quick) check how the smooth rod is sampled: a program JAX can cache, and as
+accurate as one integration saving at every arc length.
 """
 
 import jax.numpy as jnp
