@@ -108,9 +108,6 @@ def _compile(problem: Problem, args: tuple, options: tuple, devices):
     """The executable of `jax.vmap` of `_member_solver` over the batch axis of `args[-1]`
     (`jax.shard_map` over `devices` when given), compiled for `args`."""
     method, tol, max_steps = options
-    # the host-side analysis (sparsity pattern, multigrid hierarchy) from the concrete problem,
-    # as `solve` makes it, and its errors before any tracing
-    linear_solver_of(problem, spec_of(problem), method, args[3])
     batched = jax.vmap(_member_solver(problem, method, tol, max_steps), in_axes=(None, None, None, None, 0))
     if devices is not None:
         # shard_map, not jit with shardings: XLA's partitioner cannot split KLU's custom call,
@@ -133,8 +130,17 @@ def _placed(args: tuple, size: int, devices) -> tuple:
     if padded > size:
         batched = jax.tree_util.tree_map(lambda a: jnp.concatenate([a, jnp.repeat(a[-1:], padded - size, axis=0)]), batched)
     mesh = _mesh(devices)
-    shared = jax.device_put(args[:-1], NamedSharding(mesh, PartitionSpec()))
+    shared = jax.tree_util.tree_map(lambda a: _replicated(a, NamedSharding(mesh, PartitionSpec())), args[:-1])
     return (*shared, jax.device_put(batched, NamedSharding(mesh, PartitionSpec(BATCH_AXIS))))
+
+
+def _replicated(a: jax.Array, sharding: NamedSharding) -> jax.Array:
+    """`a` on every device of the mesh, each process placing its own value on its devices.
+
+    Not `jax.device_put`, which checks across processes that the values are equal: the address
+    of KLU's analysis (a leaf of the bound linear solver) is each process's own."""
+    return jax.make_array_from_single_device_arrays(
+        a.shape, sharding, [jax.device_put(a, device) for device in sharding.addressable_devices])
 
 
 def solve_batch(
@@ -215,7 +221,11 @@ def solve_batch(
     batched, shared = _split_params(problem, params_batch)
     size = _batch_size(batched)
     devices = _device_tuple(devices)
-    args = batch_arguments(problem, shared, linear_solver, batched)
+    # the host-side analysis (sparsity pattern, KLU's analysis, multigrid hierarchy) from the
+    # concrete problem, as `solve` makes it, and its errors, before any tracing; bound, the
+    # solver's index arrays are arguments of the compiled program, not constants in it
+    linear = linear_solver_of(problem, spec_of(problem), method, linear_solver)
+    args = batch_arguments(problem, shared, linear, batched)
     if devices is not None:
         args = _placed(args, size, devices)
     options = (method, float(tol), int(max_steps))

@@ -458,10 +458,8 @@ class SparseDirect(AssembledSparse):
         self.factoriser = factoriser
         super().__init__(pattern, index)
 
-    def bind(self, problem, spec):
-        from ._sparse import cached_pattern
-
-        return type(self)(cached_pattern(spec, problem.x0, problem.params), factoriser=self.factoriser)
+    def on(self, pattern):
+        return type(self)(pattern, factoriser=self.factoriser)
 
     def tree_flatten(self):
         children, aux = super().tree_flatten()

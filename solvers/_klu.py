@@ -165,7 +165,14 @@ class AssembledSparse(LinearSolver):
         return {}
 
     def bind(self, problem, spec):
-        return type(self)(cached_pattern(spec, problem.x0, problem.params))
+        """This back end on the problem's pattern; itself if already bound to it (its index
+        arrays may then be arguments of a traced function: `solve_batch` passes them so)."""
+        pattern = cached_pattern(spec, problem.x0, problem.params)
+        return self if self.pattern is pattern else self.on(pattern)
+
+    def on(self, pattern: SparsePattern) -> AssembledSparse:
+        """A solver of this kind on `pattern`, with its index arrays and analysis made now."""
+        return type(self)(pattern)
 
     def tree_flatten(self):
         names = () if self.index is None else tuple(sorted(self.index))

@@ -245,7 +245,10 @@ class Krylov(LinearSolver):
     def bind(self, problem, spec) -> Krylov:
         """Assembled products for a problem declared local, with the block-tridiagonal
         preconditioner if it is a chain (or the multigrid one if asked); autodiff products
-        otherwise."""
+        otherwise; itself if already bound to the problem's pattern (its index arrays may then
+        be arguments of a traced function: `solve_batch` passes them so)."""
+        if spec.is_local and self.pattern is not None and self.pattern is cached_pattern(spec, problem.x0, problem.params):
+            return self
         if self.preconditioner == "amg":
             return self._bind_amg(problem, spec)
         if not spec.is_local:

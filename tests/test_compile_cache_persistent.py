@@ -2,7 +2,8 @@
 off, and that a second process loads the solver the first compiled instead of compiling it.
 
 A program hits only if its lowered text is the same in every process: the KLU analysis' address
-is therefore an argument of the solver, not a constant (`solvers/_klu.py`).  The negative control
+is therefore an argument of the solver, not a constant (`solvers/_klu.py`), in `solve` and in
+`solve_batch` alike.  The negative control
 bakes a process-dependent constant into a program and sees it miss.  Programs with host callbacks
 (the `SparseDirect` factorisations) are never cached: they neither hit nor miss, they compile
 (`compiles` counts XLA's compilations).
@@ -30,6 +31,13 @@ SECTIONS = {
 from energies import elastica
 from solvers import solve, KLU
 result = solve(elastica.clamped(12, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0)), linear_solver=KLU())
+""",
+    "solve_batch": """
+import numpy as np
+from energies import elastica
+from solvers import solve_batch
+problem = elastica.clamped(10, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+result = solve_batch(problem, {"chord": np.array([[0.5, 0.2, 0.0], [0.55, 0.2, 0.1]])}, method="sparse")
 """,
     "process_dependent": """
 import os, jax, jax.numpy as jnp
@@ -100,6 +108,8 @@ def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
     - the solver itself (`solvers/_exported.py`): the first process traces and lowers it once
       (its export), the second lowers only the call of the exported program, and the
       solutions agree bit for bit;
+    - a batch solve: the same, and the batched solver's program is loaded too (the KLU
+      analysis' address is its argument, as the bound linear solver's leaf);
     - negative control: a program with a process-dependent constant misses;
     - `max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
       factorisation, so no host callback, which JAX never caches: the second process loads it;
@@ -113,6 +123,10 @@ def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
     assert "jit(_solve_impl)" in solve_1["lowered"] and "jit(call)" in solve_1["lowered"]
     assert "jit(_solve_impl)" not in solve_2["lowered"] and "jit(call)" in solve_2["lowered"]
     assert solve_2["result"] == solve_1["result"]
+    batch_1, batch_2 = first["solve_batch"], second["solve_batch"]
+    assert batch_1["misses"] > 0 and "jit(one)" in batch_1["lowered"]
+    assert {k: batch_2[k] for k in ("misses", "compiles")} == {"misses": 0, "compiles": 0}
+    assert batch_2["hits"] >= 1 and batch_2["result"] == batch_1["result"]
     assert second["process_dependent"]["misses"] >= 1
     assert first["no_steps"]["misses"] > 0 and second["no_steps"]["compiles"] == 0
     assert second["host_callback"]["misses"] == 0 and second["host_callback"]["compiles"] == 1

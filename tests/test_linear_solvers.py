@@ -188,3 +188,15 @@ def test_pardiso_solvers_name_the_mkl_runtime_once_found(monkeypatch, tmp_path):
     own.symlink_to(path)
     monkeypatch.setenv("PYPARDISO_MKL_RT", str(own))
     assert pardiso_solver(11).libmkl._name == str(own) and os.environ["PYPARDISO_MKL_RT"] == str(own)
+
+
+@pytest.mark.parametrize("make", [KLU, SparseDirect, Krylov], ids=["KLU", "SparseDirect", "Krylov"])
+def test_a_solver_bound_to_the_problems_pattern_binds_to_itself_and_to_another_pattern_anew(make):
+    """`bind` keeps a solver already bound to the problem's sparsity pattern (`solve_batch` passes
+    the bound solver, its index arrays traced, into `solve`), and binds one bound to another
+    problem anew (negative control: keeping it would solve with the wrong pattern)."""
+    small, large = (elastica.clamped(n, chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0)) for n in (8, 10))
+    bound = make().bind(small, spec_of(small))
+    assert bound.pattern is not None and bound.bind(small, spec_of(small)) is bound
+    other = bound.bind(large, spec_of(large))
+    assert other is not bound and other.pattern.n == spec_of(large).n != bound.pattern.n
