@@ -286,7 +286,7 @@ def _member_params(grid: dict, k: int) -> dict:
 
 
 def _failure_message(residual: float, steps: int, status: int, tol: float) -> str:
-    why = {1: "reached max_steps", 2: "stalled (no step decreases the residual)",
+    why = {1: "reached max_steps", 2: "stalled (no step decreases the residual, or it has not halved in 20 steps)",
            3: "the energy or its derivatives became non-finite"}.get(status, f"status {status}")
     return f"did not converge: {why} after {steps} steps, KKT residual {residual:.3e} > tol {tol:.1e}"
 

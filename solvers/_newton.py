@@ -12,6 +12,9 @@ of `φ` for every ν > 0, with `ν = θ|R|` and θ adapted like a trust region r
 of actual to predicted decrease of `φ` (Fan–Yuan).  LM steps are well defined when K is
 singular (continuous symmetries, where the solutions form a manifold), and converge there too.
 
+The iteration stops as stalled when the residual has not halved in `STAGNATION_STEPS` steps
+(`_stagnant`): `solve`'s `warm_start="auto"` then retries from an L-BFGS minimisation.
+
 The merit is the size of the residual, not the energy, so saddle points (Euler's figure-eight
 elastica) are found as readily as minima.  A minimisation problem started very far away is
 better served by `warm_start="lbfgs"`.  The iteration is one `lax.while_loop` and the trials
@@ -29,11 +32,13 @@ import jax.numpy as jnp
 from ._kkt import KKT, scaled_residual
 
 CONVERGED, MAX_STEPS, STALLED, NONFINITE, RUNNING = 0, 1, 2, 3, -1
+STAGNATION_STEPS = 20
+"""Steps in which the residual must fall below half its smallest value before them (`_stagnant`)."""
 STATUS_TEXT = {
     CONVERGED: "converged",
     MAX_STEPS: "reached max_steps",
-    STALLED: "stalled: no step decreases the residual (if the residual is tiny, it is at the "
-    "round-off level of float64 for this problem: loosen tol)",
+    STALLED: f"stalled: no step decreases the residual, or it has not halved in {STAGNATION_STEPS} steps (if the "
+    "residual is tiny, it is at the round-off level of float64 for this problem: loosen tol)",
     NONFINITE: "the energy or its derivatives became non-finite",
 }
 
@@ -149,6 +154,17 @@ def _trials(kkt: KKT, linear, solve, K, w, R, theta, active):
     return t.d, t.R_new, t.ok, t.theta, ~t.ok & ~t.lm & at_roundoff
 
 
+def _stagnant(history, step):
+    """Whether the residuals of the last `STAGNATION_STEPS` steps all exceed half the smallest
+    residual before them: Newton makes no progress (e.g. it has reached a singular critical point,
+    which it approaches at the rate ½ and then cannot resolve: a mesh whose triangles collapse).
+    `history[k]` is the residual after step k; no verdict in the first `STAGNATION_STEPS` steps."""
+    k = jnp.arange(history.shape[0])
+    before = jnp.min(jnp.where(k <= step - STAGNATION_STEPS, history, jnp.inf))
+    recent = jnp.min(jnp.where((k > step - STAGNATION_STEPS) & (k <= step), history, jnp.inf))
+    return recent > 0.5 * before
+
+
 def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> NewtonState:
     n = kkt.spec.n
     R0 = kkt.residual(w0)
@@ -171,6 +187,7 @@ def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> Newt
         R = jnp.where(ok, R_new, s.R)
         residual = scaled_residual(R, weights, n)
         step = s.step + 1
+        history = s.history.at[step].set(residual)
         status = jnp.where(
             residual <= tol,
             CONVERGED,
@@ -178,12 +195,12 @@ def newton(kkt: KKT, linear, w0, weights, *, tol: float, max_steps: int) -> Newt
                 ~jnp.isfinite(residual),
                 NONFINITE,
                 jnp.where(
-                    (theta >= THETA_MAX) | stuck,
+                    (theta >= THETA_MAX) | stuck | _stagnant(history, step),
                     STALLED,
                     jnp.where(step >= max_steps, MAX_STEPS, RUNNING),
                 ),
             ),
         )
-        return NewtonState(w, R, residual, theta, step, s.history.at[step].set(residual), status)
+        return NewtonState(w, R, residual, theta, step, history, status)
 
     return jax.lax.while_loop(cond, body, state)

@@ -404,3 +404,31 @@ def test_tol_must_be_finite_and_positive(tol):
     with pytest.raises(dg.errors.InvalidInputError, match="tol must be finite and positive"):
         solve(problem, tol=tol)
     assert bool(solve(problem, tol=1e-10).converged)  # negative control
+
+
+def test_stagnation_is_declared_after_the_residual_has_not_halved_in_twenty_steps():
+    """`_newton._stagnant` on residual histories: halving every step never stagnates; a history
+    that halves until step 5 and then stays flat stagnates exactly at step 5 + 20 (at step 24 the
+    smallest residual before the last 20 steps is still twice the flat value); no verdict in the
+    first 20 steps even on a flat history."""
+    from solvers._newton import STAGNATION_STEPS, _stagnant
+
+    assert STAGNATION_STEPS == 20
+    steps = np.arange(61)
+    halving = jnp.asarray(0.5**steps)
+    assert not any(bool(_stagnant(halving, k)) for k in steps)
+    flat = jnp.asarray(0.5 ** np.minimum(steps, 5))
+    verdict = [bool(_stagnant(flat, k)) for k in steps]
+    assert verdict.index(True) == 25 and all(verdict[25:])
+    assert not any(bool(_stagnant(jnp.ones(61), k)) for k in range(20))
+
+
+def test_newton_stops_on_a_problem_without_solution_once_it_stagnates():
+    """|x|² + 1 = 0 has no real solution: the residual stays at 1 after the first steps, so Newton
+    stops as stalled 20 steps after its last halving, not after the Levenberg–Marquardt damping
+    has grown to its bound (56 steps)."""
+    from solvers._newton import STALLED
+
+    problem = dg.Problem(lambda x, _: jnp.sum(x**2), np.ones(2), constraints=lambda x, _: jnp.array([x @ x + 1.0]))
+    sol = solve(problem, warm_start=None, throw=False)
+    assert int(sol.status) == STALLED and int(sol.steps) <= 22 and float(sol.residual) >= 0.99
