@@ -1,25 +1,32 @@
 """`solve_batch`: one problem solved for a batch of parameters, vectorised and sharded over devices.
 
-The compiled batch solver is cached by the problem's structure in the bounded `COMPILED`
-(`_cache.LRU`): a second call on a problem declared alike reuses the executable.
+The batch solver is `jax.vmap` of `solve`'s Newton solver (`_batch_impl`), compiled once per
+declaration, options and shapes and kept in a bounded cache (`_cache.LRU`): a second call on a
+problem declared alike reuses the executable.  On one device it is a `_exported.Program`
+(`PROGRAMS`), exported to disk like `solve`'s, so that a new process (a resumed or repeated
+`ddgjax sweep`) calls it without tracing it; split over devices, the `jax.shard_map` executable
+is kept by structure in `COMPILED`.  The bound linear solver is an argument: KLU's analysis,
+an address in each process, is never a constant of the program.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from functools import partial
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
+from ddgjax._checks import check_positive, checked_count
 from ddgjax.errors import ConvergenceError, InvalidInputError, ShapeError
 from ddgjax.problem import Problem
 
 from ._cache import LRU, cleared_by_jax
-from ._kkt import spec_of
-from ._solve import METHODS, Solution, linear_solver_of, solve
+from ._exported import Program
+from ._kkt import residual_weights, spec_of
+from ._solve import METHODS, Solution, _solve_impl, linear_solver_of
 
 BATCH_AXIS = "batch"
 
@@ -31,28 +38,20 @@ COMPILED = cleared_by_jax(LRU(COMPILED_BATCH_SOLVERS), "solvers.solve_batch exec
 """`solve_batch`'s executables by structure (`structure_key`); `jax.clear_caches()` empties it."""
 
 
-def _split_params(problem: Problem, params_batch):
-    """`(batched, shared)`: the batched leaves, and the unbatched entries of dict params (None
-    when `params_batch` has the whole structure of `problem.params`); see `_merge`.
-
-    `params_batch` is either a pytree like `problem.params` with a leading batch axis on every
-    leaf, or (for dict params) a dict of some of its keys, the others kept from `problem`.
-    """
+def _checked_batch(problem: Problem, params_batch):
+    """`params_batch`, either a pytree like `problem.params` with a leading batch axis on every
+    leaf, or (for dict params) a dict of some of its keys, the others kept from `problem`
+    (`_member_params`)."""
     base = problem.params
     if isinstance(base, dict) and isinstance(params_batch, dict) and set(params_batch) < set(base):
-        return params_batch, {k: v for k, v in base.items() if k not in params_batch}
+        return params_batch
     if jax.tree_util.tree_structure(params_batch) != jax.tree_util.tree_structure(base):
         raise ShapeError(
             "params_batch must have the structure of problem.params (or, for dict params, a subset "
             f"of its keys): got {jax.tree_util.tree_structure(params_batch)}, "
             f"expected {jax.tree_util.tree_structure(base)}"
         )
-    return params_batch, None
-
-
-def _merge(shared, member):
-    """A member's full params: its batched entries joined to the shared ones."""
-    return member if shared is None else {**shared, **member}
+    return params_batch
 
 
 def _batch_size(batched) -> int:
@@ -75,46 +74,61 @@ def _device_tuple(devices) -> tuple | None:
     return devices
 
 
-def batch_arguments(problem: Problem, shared, linear_solver, batched) -> tuple:
-    """The arrays of a batch solve, `(x0, shared, residual_scale, linear_solver, batched)`, every
-    leaf a `jax.Array`: what varies between problems declared alike is an argument of the
-    compiled solver, not a constant inside it."""
-    args = (problem.x0, shared, problem.residual_scale, linear_solver, batched)
+def batch_arguments(problem: Problem, spec, linear, batched) -> tuple:
+    """The arrays of a batch solve, `(linear solver, z0, params, weights, batched)`, every leaf a
+    `jax.Array`: what varies between problems declared alike is an argument of the compiled
+    solver, not a constant inside it.  `params` is `problem.params` (a member's shapes), whose
+    batched entries each member replaces (`_member_params`)."""
+    args = (linear, spec.layout.ravel(problem.x0), problem.params, residual_weights(problem, spec), batched)
     return jax.tree_util.tree_map(jnp.asarray, args)
 
 
-def structure_key(problem: Problem, args: tuple, options: tuple, devices) -> tuple:
+def structure_key(spec, args: tuple, options: tuple, devices) -> tuple:
     """What the compiled solver depends on: the declaration (`Spec`: the energy and constraint
     functions, by identity or, declared local, by value; the layout of the unknowns and the
     fixed entries), the options, the devices and backend, and the arguments' tree structure,
     shapes, dtypes and placements — not their values."""
     leaves, treedef = jax.tree_util.tree_flatten(args)
     avals = tuple((jax.typeof(a), a.sharding) for a in leaves)
-    return (spec_of(problem), options, devices, jax.default_backend(), treedef, avals)
+    return (spec, options, devices, jax.default_backend(), treedef, avals)
 
 
-def _member_solver(problem: Problem, method: str, tol: float, max_steps: int):
-    """`(x0, shared, residual_scale, linear_solver, p) -> Solution`: `solve` of the member with
-    batched params `p`; only `problem`'s functions and fixed entries are closed over."""
-
-    def one(x0, shared, scale, linear_solver, p):
-        member = replace(problem, x0=x0, params=_merge(shared, p), residual_scale=scale)
-        return solve(member, method=method, linear_solver=linear_solver, tol=tol, max_steps=max_steps, throw=False)
-
-    return one
+def _member_params(params, member):
+    """A member's full params: its batched entries (all of them, or some keys of dict params)
+    in place of the template's."""
+    return {**params, **member} if isinstance(params, dict) else member
 
 
-def _compile(problem: Problem, args: tuple, options: tuple, devices):
-    """The executable of `jax.vmap` of `_member_solver` over the batch axis of `args[-1]`
-    (`jax.shard_map` over `devices` when given), compiled for `args`."""
-    method, tol, max_steps = options
-    batched = jax.vmap(_member_solver(problem, method, tol, max_steps), in_axes=(None, None, None, None, 0))
-    if devices is not None:
-        # shard_map, not jit with shardings: XLA's partitioner cannot split KLU's custom call,
-        # and partitioning the batched Newton loop took minutes to compile
-        mesh = _mesh(devices)
-        replicated, split = PartitionSpec(), PartitionSpec(BATCH_AXIS)
-        batched = jax.shard_map(batched, mesh=mesh, in_specs=(replicated,) * 4 + (split,), out_specs=split, check_vma=False)
+def _batch_impl(spec, linear, z0, params, weights, batched, *, tol: float, max_steps: int) -> Solution:
+    """`solve`'s Newton solver (`_solve_impl`, no first-order phase) of every member of `batched`
+    (`jax.vmap` over its leading axis), each from `z0` with `_member_params(params, member)`."""
+
+    def member(p):
+        return _solve_impl(spec, linear, z0, _member_params(params, p), None, weights, tol=tol, max_steps=max_steps,
+                           first_order=0, newton_phase=True)
+
+    return jax.vmap(member)(batched)
+
+
+PROGRAMS = cleared_by_jax(LRU(COMPILED_BATCH_SOLVERS), "solvers.solve_batch programs")
+"""The batch solvers on one device, by declaration and options (`_exported.Program`: kept across
+processes like `solve`'s, a new process calls the exported program without tracing it)."""
+
+
+def _program(spec, tol: float, max_steps: int) -> Program:
+    static = dict(tol=tol, max_steps=max_steps)
+    return PROGRAMS.get((spec, tuple(static.items())), lambda: Program(_batch_impl, spec, static))
+
+
+def _compile_sharded(spec, args: tuple, options: tuple, devices):
+    """The executable of `_batch_impl` split over `devices` with `jax.shard_map`, compiled for `args`."""
+    _, tol, max_steps = options
+    impl = partial(_batch_impl, spec, tol=tol, max_steps=max_steps)
+    # shard_map, not jit with shardings: XLA's partitioner cannot split KLU's custom call,
+    # and partitioning the batched Newton loop took minutes to compile
+    mesh = _mesh(devices)
+    replicated, split = PartitionSpec(), PartitionSpec(BATCH_AXIS)
+    batched = jax.shard_map(impl, mesh=mesh, in_specs=(replicated,) * 4 + (split,), out_specs=split, check_vma=False)
     return jax.jit(batched).lower(*args).compile()
 
 
@@ -156,7 +170,8 @@ def solve_batch(
 ) -> Solution:
     """Solve `problem` for every member of a batch of parameters in one compiled call.
 
-    `jax.vmap` of `solve` over the parameters, jit-compiled once for the whole batch; with
+    `jax.vmap` of `solve` (its Newton solver, without the L-BFGS retry) over the parameters,
+    jit-compiled once for the whole batch (and kept across processes, module docstring); with
     `devices`, the batch is split over them (a `jax.sharding.Mesh` with one axis, `"batch"`,
     the parameters placed with `NamedSharding(mesh, PartitionSpec("batch"))` and each device
     solving its slice with `jax.shard_map`).  The batch is padded with copies of its last
@@ -218,19 +233,27 @@ def solve_batch(
     """
     if method not in METHODS or method == "lbfgs":
         raise InvalidInputError(f"solve_batch: method must be one of auto, dense, sparse, krylov, got {method!r}")
-    batched, shared = _split_params(problem, params_batch)
+    batched = _checked_batch(problem, params_batch)
     size = _batch_size(batched)
     devices = _device_tuple(devices)
+    check_positive(tol, "tol")
+    max_steps = checked_count(max_steps, 0, "max_steps")
+    spec = spec_of(problem)
+    if spec.n == 0:
+        raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
     # the host-side analysis (sparsity pattern, KLU's analysis, multigrid hierarchy) from the
     # concrete problem, as `solve` makes it, and its errors, before any tracing; bound, the
     # solver's index arrays are arguments of the compiled program, not constants in it
-    linear = linear_solver_of(problem, spec_of(problem), method, linear_solver)
-    args = batch_arguments(problem, shared, linear, batched)
-    if devices is not None:
+    linear = linear_solver_of(problem, spec, method, linear_solver)
+    args = batch_arguments(problem, spec, linear, batched)
+    if devices is None:
+        sol = _program(spec, float(tol), max_steps)(*args)
+    else:
         args = _placed(args, size, devices)
-    options = (method, float(tol), int(max_steps))
-    compiled = COMPILED.get(structure_key(problem, args, options, devices), lambda: _compile(problem, args, options, devices))
-    sol = compiled(*args)
+        options = (method, float(tol), max_steps)
+        compiled = COMPILED.get(structure_key(spec, args, options, devices),
+                                lambda: _compile_sharded(spec, args, options, devices))
+        sol = compiled(*args)
     if not sol.steps.is_fully_addressable:
         sol = _gathered(sol)
     if sol.steps.shape[0] > size:  # the padding of `_placed`

@@ -1,4 +1,4 @@
-"""`solve_batch` compiles once per structure, and keeps at most `COMPILED_BATCH_SOLVERS` executables.
+"""`solve_batch` compiles once per structure, and keeps at most `COMPILED_BATCH_SOLVERS` programs.
 
 The problem: critical points of `|x − target|² + weight·Σx⁴` on the unit sphere in Rⁿ; the
 energy counts its calls, so a call that traces (and compiles) shows in the count.
@@ -43,13 +43,18 @@ def _solve(problem: dg.Problem, targets):
 
 @pytest.fixture(autouse=True)
 def empty_cache(monkeypatch):
-    """An empty `COMPILED` with its counts at 0, and JAX's trace caches emptied, so that a
-    compile traces the energy anew (JAX keeps traces of `solve`'s inner `jit` by structure)."""
-    monkeypatch.setattr(_batch.COMPILED, "size", _batch.COMPILED_BATCH_SOLVERS)
+    """An empty `PROGRAMS` with its counts at 0, and JAX's trace caches emptied, so that a
+    compile traces the energy anew (JAX keeps traces of `solve`'s inner `jit` by structure).
+    No exported programs: a program exported by an earlier run would be called untraced
+    (`tests/test_compile_cache_persistent.py` tests that)."""
+    from solvers._exported import FOLDER_ENV
+
+    monkeypatch.setenv(FOLDER_ENV, "off")
+    monkeypatch.setattr(_batch.PROGRAMS, "size", _batch.COMPILED_BATCH_SOLVERS)
     jax.clear_caches()
-    _batch.COMPILED.cache_clear()
+    _batch.PROGRAMS.cache_clear()
     yield
-    _batch.COMPILED.cache_clear()
+    _batch.PROGRAMS.cache_clear()
 
 
 def test_second_call_on_a_problem_declared_alike_reuses_the_executable():
@@ -58,15 +63,15 @@ def test_second_call_on_a_problem_declared_alike_reuses_the_executable():
     the executable, not a constant in it: the result satisfies Lagrange's condition for 0.7."""
     targets = _targets(3)
     first, traced = _solve(_problem(3), targets)
-    assert traced > 0 and _batch.COMPILED.cache_info()[:2] == (0, 1)
+    assert traced > 0 and _batch.PROGRAMS.cache_info()[:2] == (0, 1)
     again, traced = _solve(_problem(3), targets)
-    assert traced == 0 and _batch.COMPILED.cache_info()[:2] == (1, 1)
+    assert traced == 0 and _batch.PROGRAMS.cache_info()[:2] == (1, 1)
     for a, b in zip(jax.tree_util.tree_leaves(first), jax.tree_util.tree_leaves(again)):
         np.testing.assert_allclose(np.asarray(a, float), np.asarray(b, float), rtol=0, atol=1e-12)  # history: NaN after the last step
 
     heavier = _problem(3, weight=0.7)
     other, traced = _solve(heavier, targets)
-    assert traced == 0 and _batch.COMPILED.cache_info()[:2] == (2, 1)
+    assert traced == 0 and _batch.PROGRAMS.cache_info()[:2] == (2, 1)
     assert float(jnp.max(jnp.abs(other.x - first.x))) > 1e-3
     # Lagrange's condition for weight 0.7: 2(x − t) + 4·0.7·x³ = 2λx, and |x| = 1
     x, lam, t = np.asarray(other.x), np.asarray(other.multipliers)[:, :1], np.asarray(targets)
@@ -78,18 +83,18 @@ def test_a_changed_structure_compiles_anew_and_the_cache_holds_at_most_its_bound
     """Bound 2: n = 2, 3, 4 each trace and compile, and the cache never holds more than 2 (n = 2
     is evicted).  Control, the bound raised to 8: n = 2 compiles again (a miss; its trace JAX
     still holds), n = 3, 4 are found without a trace, and the cache holds all three."""
-    monkeypatch.setattr(_batch.COMPILED, "size", 2)
+    monkeypatch.setattr(_batch.PROGRAMS, "size", 2)
     for misses, n in enumerate((2, 3, 4), start=1):
         sol, traced = _solve(_problem(n), _targets(n))
-        assert traced > 0 and _batch.COMPILED.cache_info().misses == misses
-        assert len(_batch.COMPILED) <= 2
+        assert traced > 0 and _batch.PROGRAMS.cache_info().misses == misses
+        assert len(_batch.PROGRAMS) <= 2
         assert sol.x.shape == (3, n) and bool(np.all(sol.converged))
-    assert len(_batch.COMPILED) == 2
+    assert len(_batch.PROGRAMS) == 2
 
-    monkeypatch.setattr(_batch.COMPILED, "size", 8)
+    monkeypatch.setattr(_batch.PROGRAMS, "size", 8)
     traced = [_solve(_problem(n), _targets(n))[1] for n in (2, 3, 4)]
     assert traced[1:] == [0, 0]
-    assert len(_batch.COMPILED) == 3 and _batch.COMPILED.cache_info()[:2] == (2, 4)
+    assert len(_batch.PROGRAMS) == 3 and _batch.PROGRAMS.cache_info()[:2] == (2, 4)
 
 
 def test_lru_evicts_the_least_recently_used():
@@ -102,9 +107,9 @@ def test_lru_evicts_the_least_recently_used():
 
 
 def test_jax_clear_caches_empties_the_cache():
-    _batch.COMPILED.get("placeholder", lambda: 0)
+    _batch.PROGRAMS.get("placeholder", lambda: 0)
     jax.clear_caches()
-    assert len(_batch.COMPILED) == 0
+    assert len(_batch.PROGRAMS) == 0
 
 
 def test_solve_keeps_a_bounded_number_of_compiled_solvers(monkeypatch):

@@ -108,8 +108,9 @@ def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
     - the solver itself (`solvers/_exported.py`): the first process traces and lowers it once
       (its export), the second lowers only the call of the exported program, and the
       solutions agree bit for bit;
-    - a batch solve: the same, and the batched solver's program is loaded too (the KLU
-      analysis' address is its argument, as the bound linear solver's leaf);
+    - a batch solve: the same; its program is exported by the first process and called
+      untraced by the second, and the KLU analysis' address is its argument (the bound linear
+      solver's leaf), not a constant;
     - negative control: a program with a process-dependent constant misses;
     - `max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
       factorisation, so no host callback, which JAX never caches: the second process loads it;
@@ -124,8 +125,9 @@ def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
     assert "jit(_solve_impl)" not in solve_2["lowered"] and "jit(call)" in solve_2["lowered"]
     assert solve_2["result"] == solve_1["result"]
     batch_1, batch_2 = first["solve_batch"], second["solve_batch"]
-    assert batch_1["misses"] > 0 and "jit(one)" in batch_1["lowered"]
+    assert batch_1["misses"] > 0 and "jit(_batch_impl)" in batch_1["lowered"]
     assert {k: batch_2[k] for k in ("misses", "compiles")} == {"misses": 0, "compiles": 0}
+    assert "jit(_batch_impl)" not in batch_2["lowered"] and "jit(call)" in batch_2["lowered"]
     assert batch_2["hits"] >= 1 and batch_2["result"] == batch_1["result"]
     assert second["process_dependent"]["misses"] >= 1
     assert first["no_steps"]["misses"] > 0 and second["no_steps"]["compiles"] == 0
