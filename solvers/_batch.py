@@ -19,14 +19,12 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
-from ddgjax._checks import check_positive, checked_count
 from ddgjax.errors import ConvergenceError, InvalidInputError, ShapeError
 from ddgjax.problem import Problem
 
 from ._cache import LRU, cleared_by_jax
 from ._exported import Program
-from ._kkt import residual_weights, spec_of
-from ._solve import METHODS, Solution, _solve_impl, linear_solver_of
+from ._solve import METHODS, Solution, _solve_impl, solver_inputs
 
 BATCH_AXIS = "batch"
 
@@ -72,15 +70,6 @@ def _device_tuple(devices) -> tuple | None:
     if not devices:
         raise InvalidInputError("solve_batch: devices is empty")
     return devices
-
-
-def batch_arguments(problem: Problem, spec, linear, batched) -> tuple:
-    """The arrays of a batch solve, `(linear solver, z0, params, weights, batched)`, every leaf a
-    `jax.Array`: what varies between problems declared alike is an argument of the compiled
-    solver, not a constant inside it.  `params` is `problem.params` (a member's shapes), whose
-    batched entries each member replaces (`_member_params`)."""
-    args = (linear, spec.layout.ravel(problem.x0), problem.params, residual_weights(problem, spec), batched)
-    return jax.tree_util.tree_map(jnp.asarray, args)
 
 
 def structure_key(spec, args: tuple, options: tuple, devices) -> tuple:
@@ -236,16 +225,12 @@ def solve_batch(
     batched = _checked_batch(problem, params_batch)
     size = _batch_size(batched)
     devices = _device_tuple(devices)
-    check_positive(tol, "tol")
-    max_steps = checked_count(max_steps, 0, "max_steps")
-    spec = spec_of(problem)
-    if spec.n == 0:
-        raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
-    # the host-side analysis (sparsity pattern, KLU's analysis, multigrid hierarchy) from the
-    # concrete problem, as `solve` makes it, and its errors, before any tracing; bound, the
-    # solver's index arrays are arguments of the compiled program, not constants in it
-    linear = linear_solver_of(problem, spec, method, linear_solver)
-    args = batch_arguments(problem, spec, linear, batched)
+    # every leaf an argument of the compiled program, not a constant in it: what varies between
+    # problems declared alike, and the linear solver's index arrays and KLU's analysis (bound
+    # now, before any tracing); `problem.params` at a member's shapes, whose batched entries
+    # each member replaces (`_member_params`)
+    spec, linear, z0, weights, max_steps = solver_inputs(problem, method, linear_solver, tol, max_steps)
+    args = jax.tree_util.tree_map(jnp.asarray, (linear, z0, problem.params, weights, batched))
     if devices is None:
         sol = _program(spec, float(tol), max_steps)(*args)
     else:

@@ -205,6 +205,22 @@ def _solve_impl(spec, linear, z0, params, lam0, weights, *, tol, max_steps, firs
                     fo_steps)
 
 
+def solver_inputs(problem: Problem, method: str, linear_solver: LinearSolver | None, tol: float, max_steps: int):
+    """`(spec, linear, z0, weights, max_steps)`: the declaration, the bound linear solver (its
+    host-side analysis made now, outside any trace), the flat unknowns of x0, the residual's
+    weights and the checked step count, from which `solve` and `solve_batch` call the solver.
+
+    **Raises:** `InvalidInputError` for a non-positive `tol`, a negative `max_steps`, every
+    entry of x0 fixed, or a linear solver that does not fit the problem."""
+    check_positive(tol, "tol")
+    max_steps = checked_count(max_steps, 0, "max_steps")
+    spec = spec_of(problem)
+    if spec.n == 0:
+        raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
+    linear = linear_solver_of(problem, spec, method, linear_solver)
+    return spec, linear, spec.layout.ravel(problem.x0), residual_weights(problem, spec), max_steps
+
+
 def solve(
     problem: Problem,
     *,
@@ -267,17 +283,11 @@ def solve(
         raise InvalidInputError(f"method must be one of {METHODS}, got {method!r}")
     if warm_start not in WARM_STARTS:
         raise InvalidInputError(f"warm_start must be one of {WARM_STARTS}, got {warm_start!r}")
-    check_positive(tol, "tol")
-    max_steps = checked_count(max_steps, 0, "max_steps")
     lam0 = None if multipliers0 is None else flatten_multipliers(problem, multipliers0)
-    spec = spec_of(problem)
-    if spec.n == 0:
-        raise InvalidInputError("every entry of x0 is fixed: there is nothing to solve for")
-    linear = linear_solver_of(problem, spec, "dense" if method == "lbfgs" else method, linear_solver)
-    z0 = spec.layout.ravel(problem.x0)
+    spec, linear, z0, weights, max_steps = solver_inputs(
+        problem, "dense" if method == "lbfgs" else method, linear_solver, tol, max_steps)
     lam0 = None if lam0 is None else lam0.astype(z0.dtype)
     first_order = FIRST_ORDER_OUTER if warm_start == "lbfgs" else (int(max_steps) if method == "lbfgs" else 0)
-    weights = residual_weights(problem, spec)
 
     def run(first_order: int) -> Solution:
         return _solve_jit(spec, linear, z0, problem.params, lam0, weights, tol=float(tol), max_steps=int(max_steps),
