@@ -80,7 +80,7 @@ import h5py
 import jax
 import numpy as np
 
-from solvers import solve, solve_batch
+from solvers import STATUS_TEXT, solve, solve_batch
 
 from .errors import InvalidInputError
 from .problem import Problem
@@ -286,9 +286,8 @@ def _member_params(grid: dict, k: int) -> dict:
 
 
 def _failure_message(residual: float, steps: int, status: int, tol: float) -> str:
-    why = {1: "reached max_steps", 2: "stalled (no step decreases the residual, or it has not halved in 20 steps)",
-           3: "the energy or its derivatives became non-finite"}.get(status, f"status {status}")
-    return f"did not converge: {why} after {steps} steps, KKT residual {residual:.3e} > tol {tol:.1e}"
+    why = STATUS_TEXT.get(status, f"status {status}")
+    return f"did not converge after {steps} steps, KKT residual {residual:.3e} > tol {tol:.1e}: {why}"
 
 
 def _rows_of(sol, count: int, tol: float) -> dict:

@@ -18,10 +18,11 @@ from ._klu import KLU as KLU
 from ._krylov import Krylov as Krylov
 from ._linear import LinearSolver as LinearSolver
 from ._minimize import minimize as minimize
+from ._newton import STATUS_TEXT as STATUS_TEXT
 from ._solve import Solution as Solution
 from ._solve import solve as solve
 from ._stability import Stability as Stability
 from ._stability import stability as stability
 
 __all__ = ["solve", "minimize", "solve_batch", "Solution", "LinearSolver", "DenseLU", "KLU", "SparseDirect", "Krylov",
-           "stability", "Stability", "continuation", "Branch", "Bifurcation"]
+           "stability", "Stability", "continuation", "Branch", "Bifurcation", "STATUS_TEXT"]

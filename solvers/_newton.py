@@ -41,6 +41,7 @@ STATUS_TEXT = {
     "residual is tiny, it is at the round-off level of float64 for this problem: loosen tol)",
     NONFINITE: "the energy or its derivatives became non-finite",
 }
+"""What `Solution.status` means, by its value (`solvers.STATUS_TEXT`)."""
 
 ARMIJO = 1e-4
 NEWTON_MU = 1e-14

@@ -83,6 +83,9 @@ def test_infeasible_member_is_recorded_failed_the_others_converge(cold):
     assert data["done"].all()
     assert np.flatnonzero(~data["converged"]).tolist() == [INFEASIBLE]
     assert data["error"][INFEASIBLE].startswith("did not converge") and "KKT residual" in data["error"][INFEASIBLE]
+    from solvers import STATUS_TEXT  # the reason, as the solver states it for the member's status
+
+    assert data["error"][INFEASIBLE].endswith(STATUS_TEXT[int(data["status"][INFEASIBLE])])
     assert all(e == "" for k, e in enumerate(data["error"]) if k != INFEASIBLE)
     assert sweep.summary(cold) == {"members": MEMBERS, "done": MEMBERS, "converged": MEMBERS - 1, "failed": 1}
 
