@@ -268,12 +268,14 @@ def test_sparse_solves_match_dense(back_end):
     kkt = KKT(spec, spec.layout.ravel(problem.x0), problem.params)
     rng = np.random.default_rng(3)
     w, b = (jnp.asarray(rng.normal(size=spec.n + spec.m)) for _ in range(2))
-    x = jax.jit(lambda w, b: algebra.solve(kkt, w, 0.0, b))(w, b)
+    # the bound back end is an argument, not a constant: KLU's analysis is an address of this
+    # process, which as a constant would keep the program out of the persistent cache
+    x = jax.jit(lambda algebra, w, b: algebra.solve(kkt, w, 0.0, b))(algebra, w, b)
     K = np.asarray(jax.jit(jax.hessian(kkt.lagrangian))(w))
     assert np.max(np.abs(K @ np.asarray(x) - np.asarray(b))) <= 1e-10
-    d = jax.jit(lambda w, b: algebra.lm_solve_matrix(algebra.matrix(kkt, w), 0.3, b))(w, b)  # (KᵀK + νI) d = −Kᵀ b
+    d = jax.jit(lambda algebra, w, b: algebra.lm_solve_matrix(algebra.matrix(kkt, w), 0.3, b))(algebra, w, b)  # (KᵀK + νI) d = −Kᵀ b
     assert np.max(np.abs((K.T @ K + 0.3 * np.eye(len(K))) @ np.asarray(d) + K.T @ np.asarray(b))) <= 1e-10
-    Kb = jax.jit(lambda w, b: algebra.matvec(algebra.matrix(kkt, w), b))(w, b)  # the assembled K times b
+    Kb = jax.jit(lambda algebra, w, b: algebra.matvec(algebra.matrix(kkt, w), b))(algebra, w, b)  # the assembled K times b
     assert np.max(np.abs(np.asarray(Kb) - K @ np.asarray(b))) <= 1e-12 * np.max(np.abs(K @ np.asarray(b)))
 
 
@@ -300,12 +302,12 @@ def test_klu_factorised_solves_match_one_shot_solves(chord):
     rng = np.random.default_rng(5)
     w, b1, b2 = (jnp.asarray(rng.normal(size=N)) for _ in range(3))
 
-    def both(w, b1, b2):
+    def both(algebra, w, b1, b2):  # the bound KLU an argument (see test_sparse_solves_match_dense)
         fac = algebra.factor_matrix(kkt, algebra.matrix(kkt, w), 1e-14)
         once = (algebra.apply(fac, b1), algebra.apply(fac, b2))
         return once, algebra.factorised(fac, lambda solve: (solve(b1), solve(solve(b2))))
 
-    (x1, x2), (y1, y2y) = jax.jit(both)(w, b1, b2)
+    (x1, x2), (y1, y2y) = jax.jit(both)(algebra, w, b1, b2)
     assert float(jnp.max(jnp.abs(x1 - y1))) <= 1e-12 * float(jnp.max(jnp.abs(x1)))
     x2x = algebra.apply(algebra.factor_matrix(kkt, algebra.matrix(kkt, w), 1e-14), x2)
     assert float(jnp.max(jnp.abs(x2x - y2y))) <= 1e-11 * float(jnp.max(jnp.abs(x2x)))
@@ -313,7 +315,7 @@ def test_klu_factorised_solves_match_one_shot_solves(chord):
     assert np.max(np.abs(K @ np.asarray(y1) - np.asarray(b1))) <= 1e-10
     W, B1, B2 = (jnp.asarray(rng.normal(size=(4, N))) for _ in range(3))
     for axes in [(0, 0, 0), (None, 0, 0)]:  # a batch of matrices; one matrix, a batch of right-hand sides
-        (X1, _), (Y1, _) = jax.jit(jax.vmap(both, in_axes=axes))(W if axes[0] == 0 else w, B1, B2)
+        (X1, _), (Y1, _) = jax.jit(jax.vmap(both, in_axes=(None, *axes)))(algebra, W if axes[0] == 0 else w, B1, B2)
         assert float(jnp.max(jnp.abs(X1 - Y1))) <= 1e-12 * float(jnp.max(jnp.abs(X1)))
 
 
