@@ -32,9 +32,13 @@ def _sphere(level: int):
 
 
 @functools.lru_cache(maxsize=None)
-def _helfrich_energy_and_curvature(level: int):
-    V, F = _sphere(level)
-    return _energy(willmore.helfrich(V, F)), willmore.mean_curvature(V, F)
+def _helfrich_energy(level: int) -> float:
+    return _energy(willmore.helfrich(*_sphere(level)))
+
+
+@functools.lru_cache(maxsize=None)
+def _mean_curvature(level: int):
+    return willmore.mean_curvature(*_sphere(level))
 
 
 @functools.partial(jax.jit, static_argnums=0)
@@ -66,15 +70,31 @@ def _perturbed_sphere(level: int, amplitude: float, seed: int):
 # Helfrich / ∫H² dA
 
 
+@pytest.mark.slow  # a convergence study over four levels; the quick one is `ddgjax verify`'s willmore_icosphere_order
 def test_willmore_icosphere_tends_to_4pi_at_second_order():
     """Willmore's theorem: W = ∫H² dA = 4π for round spheres; the discrete W on icosphere(level)
     converges to it like h² from below (measured errors −0.862, −0.222, −0.0559, −0.0140; orders
     1.96, 1.99, 1.995)."""
-    errors = [abs(_helfrich_energy_and_curvature(k)[0] - 4 * np.pi) for k in LEVELS]
+    errors = [abs(_helfrich_energy(k) - 4 * np.pi) for k in LEVELS]
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     assert errors[-1] < 0.015
     assert np.all(np.abs(orders - 2.0) < 0.06), orders
-    assert all(_helfrich_energy_and_curvature(k)[0] < 4 * np.pi for k in LEVELS)  # approached from below
+    assert all(_helfrich_energy(k) < 4 * np.pi for k in LEVELS)  # approached from below
+
+
+def test_negative_control_the_icosphere_check_fails_unless_w_is_approached_from_below(monkeypatch, tmp_path):
+    """`willmore_icosphere_order` (verify) is ∞ when one level's W reaches 4π, even where the
+    errors |W − 4π| keep their order 2: the same errors mirrored above 4π at one level."""
+    from ddgjax.verify.checks import ext_willmore
+    from ddgjax.verify._registry import Context
+
+    below = {k: 4 * np.pi - 0.86 / 4 ** (k - 1) for k in (1, 2, 3)}  # order 2 exactly
+    ctx = Context(tmp_path, quick=True)
+    monkeypatch.setattr(ext_willmore, "_willmore_of_icosphere", below.get)
+    assert abs(ext_willmore.willmore_icosphere_order(ctx, levels=(1, 2, 3)) - 2.0) < 1e-12
+    above = {**below, 3: 8 * np.pi - below[3]}
+    monkeypatch.setattr(ext_willmore, "_willmore_of_icosphere", above.get)
+    assert ext_willmore.willmore_icosphere_order(ctx, levels=(1, 2, 3)) == float("inf")
 
 
 def test_thm_6_7_mean_curvature_is_the_cotan_laplacian_over_twice_the_area():
@@ -125,7 +145,7 @@ def test_mean_curvature_of_a_sphere_tends_to_one_over_r_with_outward_normal():
     errors = []
     for k in LEVELS:
         V, F = _sphere(k)
-        H1, A1 = _helfrich_energy_and_curvature(k)[1]
+        H1, A1 = _mean_curvature(k)
         H, A = H1 / r, A1 * r * r  # the measured exact scaling of `test_scale_invariance...`
         assert np.all(H > 0)
         errors.append(float(np.sum(A * np.abs(H - 1 / r)) / np.sum(A)))
@@ -303,7 +323,7 @@ def test_helfrich_with_area_and_volume_solves_back_to_the_icosphere():
     lam_a, lam_v = float(sol.multipliers["area"][0]), float(sol.multipliers["volume"][0])
     assert abs(2 * area * lam_a + 3 * volume * lam_v) < 1e-8 * abs(2 * area * lam_a)
     assert abs(lam_v / lam_a + 2.126) < 1e-3
-    assert abs(float(sol.energy) - _helfrich_energy_and_curvature(1)[0]) < 1e-10
+    assert abs(float(sol.energy) - _helfrich_energy(1)) < 1e-10
 
 
 def test_torus_of_revolution_energy_is_the_helfrich_energy_of_the_revolved_mesh():
