@@ -19,8 +19,8 @@ The file's name is the SHA-256 of everything the solver's trace reads (`program_
   unknowns, the constraints' structure, and the bound linear solver's static part (its
   sparsity pattern by value);
 - the solve's options and the arguments' tree, shapes, dtypes and weak types;
-- the library's own source, the versions of JAX and of the libraries traced into the solver,
-  the backend and JAX's tracing flags.
+- the library's own source below its application layer (`APPLICATION`), the versions of JAX
+  and of the libraries traced into the solver, the backend and JAX's tracing flags.
 An input the key cannot describe by value (a Python function, an unknown type) sends the solve
 down the ordinary path (`NotDescribed`): a key that missed an input would return a stale
 program, i.e. a wrong answer.  Only concrete calls on one device are exported (under `jit`,
@@ -222,14 +222,26 @@ def _feed_function(h, fn: Callable, *args) -> None:
         _feed(h, fn)
 
 
+APPLICATION = ("ddgjax/verify", "ddgjax/plot", "ddgjax/cli.py", "ddgjax/sweep.py", "ddgjax/__main__.py")
+"""The application layer, above the solvers (connectivity → geometry → energies → solvers →
+verify, plots, command line), left out of `source_digest`: the solvers never import it, so its
+code reaches a solver's trace only as an energy or a constraint, which the key describes by its
+jaxpr.  Editing a check of `verify` or the command line keeps the exported programs."""
+
+
 @functools.lru_cache(maxsize=None)
-def source_digest() -> bytes:
-    """SHA-256 of the library's source: every `.py` file of `ddgjax`, `energies` and `solvers`."""
+def source_digest(root: Path | None = None) -> bytes:
+    """SHA-256 of the library's source below the application layer: every `.py` file of
+    `ddgjax`, `energies` and `solvers` under `root` (this library's folder by default) except
+    those of `APPLICATION`."""
     h = hashlib.sha256()
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parent.parent if root is None else Path(root)
     for package in ("ddgjax", "energies", "solvers"):
         for path in sorted((root / package).rglob("*.py")):
-            h.update(str(path.relative_to(root)).encode() + b"\0")
+            name = path.relative_to(root).as_posix()
+            if any(name == part or name.startswith(part + "/") for part in APPLICATION):
+                continue
+            h.update(name.encode() + b"\0")
             h.update(path.read_bytes())
     return h.digest()
 

@@ -100,6 +100,23 @@ def test_the_library_source_is_in_the_key(monkeypatch):
     assert key(quadratic()) == base
 
 
+def test_the_source_digest_covers_the_layers_up_to_the_solvers_and_not_the_application(tmp_path):
+    """An edit of the solvers, the language or an energy changes the digest (and so every key); an
+    edit of a check of `verify`, a plot or the command line does not (`_exported.APPLICATION`)."""
+    files = ["solvers/_newton.py", "ddgjax/locality.py", "energies/rod.py", "ddgjax/verify/checks/sec1_curves.py",
+             "ddgjax/plot/lines.py", "ddgjax/cli.py", "ddgjax/sweep.py", "ddgjax/verifying.py"]
+    for name in files:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(f"# {name}\n")
+    base = _exported.source_digest(tmp_path)
+    for name in files:
+        (tmp_path / name).write_text("# edited\n")
+        changed = _exported.source_digest.__wrapped__(tmp_path) != base
+        (tmp_path / name).write_text(f"# {name}\n")
+        assert changed == (name in ("solvers/_newton.py", "ddgjax/locality.py", "energies/rod.py",
+                                    "ddgjax/verifying.py")), name
+
+
 def test_python_derivative_rules_and_host_callbacks_are_not_exported():
     @jax.custom_jvp
     def soft(x):
