@@ -156,8 +156,8 @@ def family(path_or_data, out=None):
         ax.set_ylabel(name if name != "residual" else "KKT residual")
     if shapes:
         # planar when the family's shapes are: a failed member's last iterate is no shape of it
-        family = ok if ok.any() else done
-        projection = None if np.allclose(np.nan_to_num(data["x"][family][..., 2]), 0.0) else "3d"
+        shown = ok if ok.any() else done
+        projection = None if np.allclose(np.nan_to_num(data["x"][shown][..., 2]), 0.0) else "3d"
         _draw_shapes(fig.add_subplot(1, 4, 4, projection=projection), data, ok, failed)
     problem = data.get("attrs", {}).get("problem", "sweep")
     fig.suptitle(f"{problem}: {int(done.sum())} of {len(done)} members done, {int(failed.sum())} failed", fontsize="medium")
