@@ -22,10 +22,23 @@ except ImportError:  # pragma: no cover
     def _to_concrete_value(x):
         return None
 
+try:  # whether a jit's trace is under way (JAX >= 0.4.36); without it every call counts as staged
+    from jax._src.core import unsafe_am_i_under_a_jit as _under_a_jit
+except ImportError:  # pragma: no cover
+    def _under_a_jit():
+        return True
+
 
 def is_concrete(tree) -> bool:
     """True when no leaf of `tree` is a tracer (so values can be inspected in Python)."""
     return not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(tree))
+
+
+def is_staged() -> bool:
+    """True while `jax.jit` traces a program here (also under `grad` or `vmap` inside it): an
+    array made now becomes a constant of that program, written into its text.  False outside
+    `jit`, under `grad` or `vmap` alone included."""
+    return bool(_under_a_jit())
 
 
 def concrete_value(x) -> np.ndarray | None:

@@ -18,6 +18,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ddgjax._checks import is_staged
+
 from ._kkt import KKT
 from ._linear import LinearSolver, row_regularisation
 from ._sparse import SPLIT_ARRAYS, Bordered, PatternKey, SparsePattern, cached_pattern, index_arrays, kkt_values
@@ -31,15 +33,19 @@ def _klu_solve(rows, cols, values, b, handle):
     this against `klujax.solve`).  `handle` is the analysis' address (`symbolic_handle`), an
     argument of the compiled program: as a constant it would make every process compile a
     different program, and a program loaded from the persistent cache point into another
-    process' memory.
+    process' memory.  `handle=None` (a solver bound while `jit` traces a program, where the
+    address would be such a constant): analysis, factorisation and solve in one call.
     """
     import klujax
 
     rhs = b.reshape(1, b.shape[0], -1)  # (n_lhs = 1, n_col, n_rhs)
-    solve = klujax.solve_with_symbol_c128 if jnp.iscomplexobj(values) else klujax.solve_with_symbol_f64
-    x = solve.bind(
-        jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), values[None, :], rhs, handle
-    )
+    complex_ = jnp.iscomplexobj(values)
+    indices = (jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32))
+    if handle is None:
+        x = (klujax.solve_c128 if complex_ else klujax.solve_f64).bind(*indices, values[None, :], rhs)
+    else:
+        solve = klujax.solve_with_symbol_c128 if complex_ else klujax.solve_with_symbol_f64
+        x = solve.bind(*indices, values[None, :], rhs, handle)
     return x.reshape(b.shape)
 
 
@@ -140,7 +146,7 @@ def _bordered_solve(split, index: dict, values, b):
     right-hand sides `[b_A, B]`, then `_eliminate_border`."""
     blocks = _border_blocks(split, index, values)
     rhs = jnp.concatenate([b[index["split_interior"]][:, None], blocks[0]], axis=1)
-    Y = _klu_solve(index["split_a_rows"], index["split_a_cols"], values[index["split_take_a"]], rhs, index["klu_symbolic"])
+    Y = _klu_solve(index["split_a_rows"], index["split_a_cols"], values[index["split_take_a"]], rhs, index.get("klu_symbolic"))
     return _eliminate_border(index, blocks, b, Y[:, 0], Y[:, 1:])
 
 
@@ -211,7 +217,12 @@ class KLU(AssembledSparse):
     """Sparse KKT matrix assembled from local blocks; KLU solve (klujax), inside `jit`."""
 
     def prepare(self, pattern: SparsePattern) -> dict:
-        """KLU's analysis of K (or of its interior block), made now, outside any trace."""
+        """KLU's analysis of K (or of its interior block), made now, outside any trace; none
+        while `jit` traces a program (`is_staged`): its address would be a constant of the
+        program, which then differs in every process and is never found in the persistent
+        cache, so each solve analyses in the program instead (`_klu_solve`)."""
+        if is_staged():
+            return {}
         split = pattern.split()
         return {"klu_symbolic": symbolic_handle(pattern if split is None else split)}
 
@@ -219,11 +230,14 @@ class KLU(AssembledSparse):
         split = self.pattern.split()
         if split is not None:
             return _bordered_solve(split, self.index, fac, b)
-        return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.index["klu_symbolic"])
+        return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.index.get("klu_symbolic"))
 
     def factorised(self, fac, use):
         """`use(solve)` with one KLU factorisation of `fac` for all its solves (`LinearSolver`),
-        freed after; bordered: with `A⁻¹ B` made once too."""
+        freed after; bordered: with `A⁻¹ B` made once too.  Without an analysis (`prepare`
+        while `jit` traces), each solve factorises anew."""
+        if "klu_symbolic" not in self.index:
+            return super().factorised(fac, use)
         ix, handle = self.index, self.index["klu_symbolic"]
         split = self.pattern.split()
         if split is None:

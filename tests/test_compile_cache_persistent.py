@@ -39,6 +39,15 @@ from solvers import solve_batch
 problem = elastica.clamped(10, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0))
 result = solve_batch(problem, {"chord": np.array([[0.5, 0.2, 0.0], [0.55, 0.2, 0.1]])}, method="sparse")
 """,
+    "klu_inside_jit": """
+import jax, jax.numpy as jnp
+from energies import elastica
+from solvers import solve, KLU
+problem = elastica.clamped(8, chord=(0.5, 0.2, 0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+energy = jax.jit(lambda c: solve(problem.with_params({**problem.params, "chord": c}), linear_solver=KLU(),
+                                 throw=False).energy)
+result = energy(jnp.array([0.45, 0.2, 0.0]))
+""",
     "process_dependent": """
 import os, jax, jax.numpy as jnp
 jax.jit(lambda x: x + os.getpid())(jnp.zeros(3)).block_until_ready()
@@ -111,6 +120,9 @@ def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
     - a batch solve: the same; its program is exported by the first process and called
       untraced by the second, and the KLU analysis' address is its argument (the bound linear
       solver's leaf), not a constant;
+    - a KLU solve inside the caller's own `jit` (with `throw=False`: no host callback): the
+      second process loads the caller's program; KLU analyses the pattern inside it, as the
+      analysis' address would be a constant of it;
     - negative control: a program with a process-dependent constant misses;
     - `max_steps=0` (the hand-off of `minimize`) compiles only the KKT residual at x0: no
       factorisation, so no host callback, which JAX never caches: the second process loads it;
@@ -129,6 +141,9 @@ def test_a_second_process_loads_what_the_first_compiled_and_exported(processes):
     assert {k: batch_2[k] for k in ("misses", "compiles")} == {"misses": 0, "compiles": 0}
     assert "jit(_batch_impl)" not in batch_2["lowered"] and "jit(call)" in batch_2["lowered"]
     assert batch_2["hits"] >= 1 and batch_2["result"] == batch_1["result"]
+    jitted_1, jitted_2 = first["klu_inside_jit"], second["klu_inside_jit"]
+    assert jitted_1["misses"] > 0 and {k: jitted_2[k] for k in ("misses", "compiles")} == {"misses": 0, "compiles": 0}
+    assert jitted_2["result"] == jitted_1["result"]
     assert second["process_dependent"]["misses"] >= 1
     assert first["no_steps"]["misses"] > 0 and second["no_steps"]["compiles"] == 0
     assert second["host_callback"]["misses"] == 0 and second["host_callback"]["compiles"] == 1

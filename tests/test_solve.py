@@ -319,6 +319,74 @@ def test_klu_factorised_solves_match_one_shot_solves(chord):
         assert float(jnp.max(jnp.abs(X1 - Y1))) <= 1e-12 * float(jnp.max(jnp.abs(X1)))
 
 
+def test_is_staged_only_while_jit_traces():
+    """`is_staged`: False outside `jit` (under `grad` or `vmap` alone too), True in a `jit`'s
+    trace (and under `grad` or `vmap` inside it)."""
+    from ddgjax._checks import is_staged
+
+    seen = []
+
+    def probe(x):
+        seen.append(is_staged())
+        return x * x
+
+    probe(1.0)
+    jax.grad(probe)(1.0)
+    jax.vmap(probe)(jnp.ones(2))
+    jax.jit(probe)(1.0)
+    jax.jit(jax.grad(probe))(2.0)
+    jax.jit(jax.vmap(probe))(jnp.ones(3))
+    assert seen == [False, False, False, True, True, True]
+
+
+@pytest.mark.parametrize("chord", [None, (7.5, 3.5, 0.2)], ids=["plain", "bordered"])
+def test_klu_bound_while_jit_traces_analyses_inside_the_program(chord):
+    """Bound outside any trace, KLU carries the address of its analysis (an argument of the
+    programs); bound while `jit` traces, none, since the address would be a constant of the
+    caller's program, different in every process (`tests/test_compile_cache_persistent.py`):
+    each solve then analyses, factorises and solves in one call.  Both give the same solves,
+    plain and bordered."""
+    from solvers._klu import KLU
+
+    algebra, kkt, N = _klu_chain(9, chord)
+    assert "klu_symbolic" in algebra.index
+    rng = np.random.default_rng(3)
+    w, b = (jnp.asarray(rng.normal(size=N)) for _ in range(2))
+
+    def solves(algebra):
+        fac = algebra.factor_matrix(kkt, algebra.matrix(kkt, w), 1e-14)
+        return algebra.apply(fac, b), algebra.factorised(fac, lambda solve: solve(solve(b)))
+
+    staged = {}
+
+    def inside(w_unused):
+        staged["index"] = set(KLU(algebra.pattern).index)
+        return solves(KLU(algebra.pattern))
+
+    (x, y), (xs, ys) = solves(algebra), jax.jit(inside)(w)
+    assert "klu_symbolic" not in staged["index"]
+    assert float(jnp.max(jnp.abs(x - xs))) <= 1e-12 * float(jnp.max(jnp.abs(x)))
+    assert float(jnp.max(jnp.abs(y - ys))) <= 1e-11 * float(jnp.max(jnp.abs(y)))
+
+
+def test_klu_solutions_and_gradients_inside_jit_equal_those_outside():
+    """The energy of the clamped elastica and its gradient in the chord (a bordered KKT matrix)
+    through `solve` with KLU: under `jit` (analysis inside the program) as without (`grad`
+    alone: the analysis' address an argument)."""
+    from energies import elastica
+    from solvers._klu import KLU
+
+    problem = elastica.clamped(10, chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+
+    def energy(c):
+        return solve(problem.with_params({**problem.params, "chord": c}), linear_solver=KLU(), throw=False).energy
+
+    c = jnp.array([0.45, 0.2, 0.0])
+    (e, g), (e_jit, g_jit) = jax.value_and_grad(energy)(c), jax.jit(jax.value_and_grad(energy))(c)
+    assert abs(float(e - e_jit)) <= 1e-12 * abs(float(e))
+    assert float(jnp.max(jnp.abs(g - g_jit))) <= 1e-10 * float(jnp.max(jnp.abs(g)))
+
+
 def _rss_mib() -> float:
     for line in open("/proc/self/status"):
         if line.startswith("VmRSS"):
