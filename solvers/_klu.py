@@ -73,8 +73,21 @@ def _klu_solve_factored(numeric, b, handle):
     return solve.bind(handle, numeric, b.reshape(1, b.shape[0], -1)).reshape(b.shape)
 
 
-FREE_NUMERIC = "ddgjax_klu_free_numeric"
+FREE_NUMERIC, FREE_SYMBOLIC = "ddgjax_klu_free_numeric", "ddgjax_klu_free_symbolic"
 _REGISTERED: set = set()  # FFI targets registered in this process
+
+
+def _klu_analyze(rows, cols, size: int):
+    """KLU's analysis of the pattern (rows, cols) of a size×size matrix, made inside the
+    program: its address, a uint64 scalar, to be freed by `_klu_free_symbolic`.
+
+    klujax's `analyze` handler, called as an operation with a side effect: XLA would otherwise
+    merge two analyses of one pattern (common-subexpression elimination) or hoist one out of a
+    loop, both of which free it (twice, or in every iteration)."""
+    import klujax  # noqa: F401  (registers its handler "analyze")
+
+    analyze = jax.ffi.ffi_call("analyze", jax.ShapeDtypeStruct((), jnp.uint64), has_side_effect=True)
+    return analyze(jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), jnp.int32(size))
 
 
 def _klu_free(numeric, after) -> None:
@@ -86,30 +99,46 @@ def _klu_free(numeric, after) -> None:
     every solve with the factors, so its operand is made to depend on all of `after`
     (`_depending_on`).  Under `vmap` a batch of factors is freed by one call, and factors
     shared by the batch (a matrix that does not depend on the batched values) once."""
-    _register_free_numeric()
-    _free_after(numeric, after)
+    _register_frees()
+    _free_numeric_after(numeric, after)
 
 
-def _register_free_numeric() -> None:
-    """Register `FREE_NUMERIC` (klujax's `free_numeric` handler) once per process."""
+def _klu_free_symbolic(handle, after) -> None:
+    """Free the analysis `handle` made in the program (`_klu_analyze`) once `after` is computed,
+    by klujax's `free_symbolic` handler; once, also under `vmap` (`_klu_free`)."""
+    _register_frees()
+    _free_symbolic_after(handle, after)
+
+
+def _register_frees() -> None:
+    """Register `FREE_NUMERIC` and `FREE_SYMBOLIC` (klujax's handlers) once per process."""
     import klujax_cpp
 
-    if FREE_NUMERIC not in _REGISTERED:
-        jax.ffi.register_ffi_target(FREE_NUMERIC, klujax_cpp.free_numeric(), platform="cpu")
-        _REGISTERED.add(FREE_NUMERIC)
+    for name, handler in ((FREE_NUMERIC, klujax_cpp.free_numeric), (FREE_SYMBOLIC, klujax_cpp.free_symbolic)):
+        if name not in _REGISTERED:
+            jax.ffi.register_ffi_target(name, handler(), platform="cpu")
+            _REGISTERED.add(name)
 
 
-@jax.custom_batching.custom_vmap
-def _free_after(numeric, after):
-    free = jax.ffi.ffi_call(FREE_NUMERIC, jax.ShapeDtypeStruct((), jnp.int32), has_side_effect=True)
-    return free(_depending_on(numeric, after))
+def _free_after(target: str):
+    """`free(handle, after)`: the FFI handler `target` called on `handle` once `after` is
+    computed.  Under `vmap` the whole (batched or shared) `handle` goes to one call, whose
+    batch axis is just another axis there: a batch of factors is freed together, an analysis or
+    factors shared by the batch once."""
+
+    @jax.custom_batching.custom_vmap
+    def free(handle, after):
+        call = jax.ffi.ffi_call(target, jax.ShapeDtypeStruct((), jnp.int32), has_side_effect=True)
+        return call(_depending_on(handle, after))
+
+    @free.def_vmap
+    def free_batched(axis_size, in_batched, handle, after):
+        return free(handle, after), False
+
+    return free
 
 
-@_free_after.def_vmap
-def _free_after_batched(axis_size, in_batched, numeric, after):
-    """Batched factors are freed together, factors shared by the batch once: `_free_after` on
-    the whole arrays, whose batch axis is just another axis here."""
-    return _free_after(numeric, after), False
+_free_numeric_after, _free_symbolic_after = _free_after(FREE_NUMERIC), _free_after(FREE_SYMBOLIC)
 
 
 def _depending_on(handle, after):
@@ -220,7 +249,7 @@ class KLU(AssembledSparse):
         """KLU's analysis of K (or of its interior block), made now, outside any trace; none
         while `jit` traces a program (`is_staged`): its address would be a constant of the
         program, which then differs in every process and is never found in the persistent
-        cache, so each solve analyses in the program instead (`_klu_solve`)."""
+        cache, so the program analyses the pattern itself (`analysed`, `_klu_solve`)."""
         if is_staged():
             return {}
         split = pattern.split()
@@ -232,10 +261,26 @@ class KLU(AssembledSparse):
             return _bordered_solve(split, self.index, fac, b)
         return _klu_solve(self.index["rows"], self.index["cols"], fac, b, self.index.get("klu_symbolic"))
 
+    def analysed(self, run):
+        """`run(self)`; without an analysis (`prepare` while `jit` traces), with one made in the
+        program before `run`'s solves and freed after them.  The analysis is not made per
+        factorisation: XLA would hoist it, a pure function of constant indices, out of Newton's
+        loop, while the free stayed inside."""
+        if "klu_symbolic" in self.index:
+            return run(self)
+        split, ix = self.pattern.split(), self.index
+        if split is None:
+            handle = _klu_analyze(ix["rows"], ix["cols"], self.pattern.n + self.pattern.m)
+        else:
+            handle = _klu_analyze(ix["split_a_rows"], ix["split_a_cols"], len(split.interior))
+        out = run(type(self)(self.pattern, {**ix, "klu_symbolic": handle}))
+        _klu_free_symbolic(handle, out)
+        return out
+
     def factorised(self, fac, use):
         """`use(solve)` with one KLU factorisation of `fac` for all its solves (`LinearSolver`),
         freed after; bordered: with `A⁻¹ B` made once too.  Without an analysis (`prepare`
-        while `jit` traces), each solve factorises anew."""
+        while `jit` traces, outside `analysed`), each solve factorises anew."""
         if "klu_symbolic" not in self.index:
             return super().factorised(fac, use)
         ix, handle = self.index, self.index["klu_symbolic"]
@@ -265,10 +310,10 @@ class KLU(AssembledSparse):
 
 def ffi_targets() -> tuple[str, ...]:
     """The custom-call targets a program with KLU solves may call, registered in this process:
-    klujax's (under the names of `klujax_cpp`'s handlers) and `FREE_NUMERIC`."""
+    klujax's (under the names of `klujax_cpp`'s handlers), `FREE_NUMERIC` and `FREE_SYMBOLIC`."""
     import klujax  # noqa: F401  (registers its targets)
     import klujax_cpp
 
-    _register_free_numeric()
+    _register_frees()
     handlers = [name for name in dir(klujax_cpp) if not name.startswith("_") and name[0].islower()]
-    return (*handlers, FREE_NUMERIC)
+    return (*handlers, FREE_NUMERIC, FREE_SYMBOLIC)

@@ -112,6 +112,12 @@ class LinearSolver(abc.ABC):
         and frees the factorisation once `use`'s result is computed."""
         return use(lambda b: self.apply(fac, b))
 
+    def analysed(self, run):
+        """`run(self)`, for a computation that factorises and solves many times (Newton's
+        iteration).  A back end that has not analysed its matrix's pattern in advance (KLU bound
+        while `jit` traces) analyses it here once for all of them, and frees the analysis after."""
+        return run(self)
+
     def apply_transpose(self, fac, b):
         """`(K + μS)ᵀ⁻¹ b`; K and S are symmetric."""
         return self.apply(fac, b)

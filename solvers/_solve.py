@@ -174,26 +174,30 @@ def _solve_impl(spec, linear, z0, params, lam0, weights, *, tol, max_steps, firs
     u0 = z0_[spec.layout.free]
     if lam0 is None and spec.m == 0:
         lam0 = jnp.zeros((0,), u0.dtype)
-    if lam0 is None:
-        # least-squares multipliers argmin |∇E − Jᵀλ|: the KKT system with ∇²L replaced by I
-        grad_e = jax.grad(kkt.energy)(u0)
-        w_probe = jnp.concatenate([u0, jnp.zeros((spec.m,), u0.dtype)])
-        rhs = jnp.concatenate([grad_e, jnp.zeros((spec.m,), u0.dtype)])
-        lam0 = -linear.solve(kkt, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
-        lam0 = jnp.where(jnp.isfinite(lam0), lam0, 0.0)
-    w = jnp.concatenate([u0, lam0])
-    fo_steps = jnp.asarray(0)
-    if first_order:
-        w, fo_steps, _ = augmented_lagrangian(kkt, w, weights, tol=tol, outer_steps=first_order)
-    if newton_phase:
-        state = newton(kkt, linear, w, weights, tol=tol, max_steps=max_steps)
-        w, residual, steps, history, status = state.w, state.residual, state.step, state.history, state.status
-    else:
-        residual = scaled_residual(kkt.residual(w), weights, spec.n)
-        steps, history = fo_steps, jnp.full((max_steps + 1,), jnp.nan).at[0].set(residual)
-        finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
-        status = jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE))
 
+    def iterate(linear):
+        """The critical point from (u0, lam0): `(w, residual, steps, history, status, fo_steps)`."""
+        lam = lam0
+        if lam is None:
+            # least-squares multipliers argmin |∇E − Jᵀλ|: the KKT system with ∇²L replaced by I
+            grad_e = jax.grad(kkt.energy)(u0)
+            w_probe = jnp.concatenate([u0, jnp.zeros((spec.m,), u0.dtype)])
+            rhs = jnp.concatenate([grad_e, jnp.zeros((spec.m,), u0.dtype)])
+            lam = -linear.solve(kkt, w_probe, 1e-12, rhs, identity_hessian=True)[spec.n :]
+            lam = jnp.where(jnp.isfinite(lam), lam, 0.0)
+        w = jnp.concatenate([u0, lam])
+        fo_steps = jnp.asarray(0)
+        if first_order:
+            w, fo_steps, _ = augmented_lagrangian(kkt, w, weights, tol=tol, outer_steps=first_order)
+        if newton_phase:
+            state = newton(kkt, linear, w, weights, tol=tol, max_steps=max_steps)
+            return state.w, state.residual, state.step, state.history, state.status, fo_steps
+        residual = scaled_residual(kkt.residual(w), weights, spec.n)
+        history = jnp.full((max_steps + 1,), jnp.nan).at[0].set(residual)
+        finite = jnp.isfinite(residual) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
+        return w, residual, fo_steps, history, jnp.where(residual <= tol, CONVERGED, jnp.where(finite, 1, NONFINITE)), fo_steps
+
+    w, residual, steps, history, status, fo_steps = linear.analysed(iterate)
     converged = (residual <= tol) & jnp.isfinite(kkt.energy(kkt.split(w)[0]))
     status = jnp.where((status == CONVERGED) & ~converged, NONFINITE, status)
     w = implicit_solution(spec, jax.lax.stop_gradient(linear), w, z0, params, converged)

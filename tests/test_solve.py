@@ -387,6 +387,62 @@ def test_klu_solutions_and_gradients_inside_jit_equal_those_outside():
     assert float(jnp.max(jnp.abs(g - g_jit))) <= 1e-10 * float(jnp.max(jnp.abs(g)))
 
 
+def _custom_calls_per_computation(hlo: str, target: str) -> dict:
+    """`{computation: count}` of the custom calls to `target` in an optimised HLO module's text."""
+    import collections
+    import re
+
+    where, current = collections.Counter(), None
+    for line in hlo.splitlines():
+        if heading := re.match(r"^(?:ENTRY )?%?([\w.\-]+) .*\{$", line):
+            current = heading.group(1)
+        if f'custom_call_target="{target}"' in line:
+            where[current] += 1
+    return dict(where)
+
+
+def test_klu_analyses_inside_a_callers_program_are_each_freed_where_they_are_made():
+    """A caller's `jit` with two solves of one declaration and a loop of solves: after XLA's
+    optimisations every analysis made in the program sits in the computation (the loop's body
+    or the entry) that frees it, once; the values equal the solves outside `jit`.  Negative
+    control: the same analysis as a pure operation is merged by XLA's common-subexpression
+    elimination and hoisted out of the loop, while the frees stay where they were (a double
+    free and a use after free, not run here)."""
+    import klujax
+
+    import solvers._klu as klu
+    from energies import elastica
+    from solvers._klu import FREE_SYMBOLIC, KLU
+
+    problem = elastica.clamped(12, chord=(0.5, 0.2, 0.0), t_start=(1, 0, 0), t_end=(0, 1, 0))
+
+    def energy(c):
+        return solve(problem.with_params({**problem.params, "chord": c}), linear_solver=KLU(), throw=False).energy
+
+    def program(c):
+        return jax.lax.fori_loop(0, 3, lambda i, acc: acc + energy(c + 0.001 * i), 0.0) + energy(c) + energy(c)
+
+    def placement():
+        hlo = jax.jit(program).lower(c).compile().as_text()
+        return _custom_calls_per_computation(hlo, "analyze"), _custom_calls_per_computation(hlo, FREE_SYMBOLIC)
+
+    c = jnp.array([0.45, 0.2, 0.0])
+    analyses, frees = placement()
+    assert analyses == frees and sum(analyses.values()) == 3 and len(analyses) == 2
+    expected = sum(float(energy(c + 0.001 * i)) for i in range(3)) + 2 * float(energy(c))
+    assert abs(float(jax.jit(program)(c)) - expected) <= 1e-12 * abs(expected)
+    analyze = klu._klu_analyze
+    klu._klu_analyze = lambda rows, cols, size: klujax.analyze_p.bind(
+        jnp.asarray(rows, jnp.int32), jnp.asarray(cols, jnp.int32), jnp.int32(size))
+    try:
+        jax.clear_caches()  # the solver's traces, which hold the analysis of the first placement
+        analyses, frees = placement()
+    finally:
+        klu._klu_analyze = analyze
+        jax.clear_caches()  # and here the pure one, which no later test may run
+    assert sum(analyses.values()) < sum(frees.values()) and analyses != frees
+
+
 def _rss_mib() -> float:
     for line in open("/proc/self/status"):
         if line.startswith("VmRSS"):
