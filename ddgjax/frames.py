@@ -157,7 +157,7 @@ def _split(Phi: Array) -> tuple[Array, Array, Array]:
     T = qt.rotate(Phi, jnp.asarray(E[0]))
     _check_not_antiparallel(T)
     T_prev, T_next = T[:-1], T[1:]
-    b = jnp.concatenate([1 + jnp.sum(T_prev * T_next, -1, keepdims=True), jnp.cross(T_prev, T_next)], -1)
+    b = jnp.concatenate([1 + jnp.sum(T_prev * T_next, -1, keepdims=True), qt.cross(T_prev, T_next)], -1)
     b = b / jnp.linalg.norm(b, axis=-1, keepdims=True)
     t = qt.mul(qt.mul(Phi[1:], qt.conj(Phi[:-1])), qt.conj(b))
     # t = ±(cos θ/2 + sin θ/2 T_k): pick the sign with cos θ/2 ≥ 0 so θ ∈ (−π, π]

@@ -39,6 +39,7 @@ __all__ = [
     "as_vector",
     "check_unit",
     "mul",
+    "cross",
     "conj",
     "norm",
     "inv",
@@ -123,13 +124,58 @@ def check_unit(q, name: str = "q", tol: float = UNIT_TOL) -> None:
 # the algebra H (3.1)
 
 
+def _levi_civita() -> np.ndarray:
+    """`ε_ijk`: the sign of the permutation (i, j, k) of (0, 1, 2), 0 when two indices agree."""
+    eps = np.zeros((3, 3, 3))
+    for i, j, k in [(0, 1, 2), (1, 2, 0), (2, 0, 1)]:
+        eps[i, j, k], eps[i, k, j] = 1.0, -1.0
+    return eps
+
+
+LEVI_CIVITA = _levi_civita()
+"""`(v × w)_i = Σ_jk ε_ijk v_j w_k` (3, 3, 3)."""
+
+
+def _hamilton() -> np.ndarray:
+    """The structure constants `C_ijk` of H, `(pq)_i = Σ_jk C_ijk p_j q_k` (3.1): 1 is the unit
+    and, for imaginary basis vectors, `e_a e_b = −δ_ab + Σ_c ε_cab e_c` (Lemma 3.4)."""
+    C = np.zeros((4, 4, 4))
+    C[:, 0, :] = C[:, :, 0] = np.eye(4)
+    C[0, 1:, 1:] = -np.eye(3)
+    C[1:, 1:, 1:] = LEVI_CIVITA
+    return C
+
+
+HAMILTON = _hamilton()
+"""`C_ijk` with `(pq)_i = Σ_jk C_ijk p_j q_k` (4, 4, 4)."""
+
+CONJUGATION = np.array([1.0, -1.0, -1.0, -1.0])
+"""`q̄ = CONJUGATION · q` (entrywise)."""
+
+SANDWICH = np.einsum("icb,caj,b->iajb", HAMILTON[1:], HAMILTON[:, :, 1:], CONJUGATION)
+"""`S_iajb` with `Im(q v q̄)_i = Σ_ajb S_iajb q_a v_j q_b` for v ∈ Im H (3, 4, 3, 4): the
+rotation `R_q(v) = q v q̄ / |q|²` (Prop 3.6) as one contraction."""
+
+
+def _cross(v: Array, w: Array) -> Array:
+    return jnp.einsum("ijk,...j,...k->...i", LEVI_CIVITA, v, w)
+
+
+def cross(v: Vector, w: Vector) -> Vector:
+    """`v × w = Σ_jk ε_ijk v_j w_k = Im(vw)` (Lemma 3.4), broadcasting over leading axes.
+
+    One contraction with `LEVI_CIVITA`, as `mul` is one with `HAMILTON` and `rotate` one with
+    `SANDWICH`: their derivatives of every order are contractions too, so a density built from
+    them differentiates into a few tensor products (the cell Hessians of a rod) rather than into
+    the slices and concatenations of a componentwise formula.  **Raises:** `ShapeError`,
+    `NonFiniteError`.
+    """
+    return _cross(as_vector(v, "v"), as_vector(w, "w"))
+
+
 @jax.jit
 def _mul(p: Array, q: Array) -> Array:
-    p0, pv = p[..., :1], p[..., 1:]
-    q0, qv = q[..., :1], q[..., 1:]
-    real = p0 * q0 - jnp.sum(pv * qv, axis=-1, keepdims=True)
-    imag = p0 * qv + q0 * pv + jnp.cross(pv, qv)
-    return jnp.concatenate([real, imag], axis=-1)
+    return jnp.einsum("ijk,...j,...k->...i", HAMILTON, p, q)
 
 
 def mul(p: Quaternion, q: Quaternion) -> Quaternion:
@@ -142,7 +188,7 @@ def mul(p: Quaternion, q: Quaternion) -> Quaternion:
 
 @jax.jit
 def _conj(q: Array) -> Array:
-    return q * jnp.asarray([1.0, -1.0, -1.0, -1.0])
+    return q * CONJUGATION
 
 
 def conj(q: Quaternion) -> Quaternion:
@@ -184,12 +230,8 @@ def to_vector(q: Quaternion) -> Vector:
 
 @jax.jit
 def _rotate(q: Array, v: Array) -> Array:
-    # q v q̄ / |q|² expanded: ((q0² − |u|²) v + 2<u, v> u + 2 q0 u × v) / |q|², u = Im q
-    q0, u = q[..., :1], q[..., 1:]
-    sq = jnp.sum(q * q, axis=-1, keepdims=True)
-    uu = jnp.sum(u * u, axis=-1, keepdims=True)
-    uv = jnp.sum(u * v, axis=-1, keepdims=True)
-    return ((q0**2 - uu) * v + 2 * uv * u + 2 * q0 * jnp.cross(u, v)) / sq
+    # q v q̄ / |q|² = ((q0² − |u|²) v + 2<u, v> u + 2 q0 u × v) / |q|², u = Im q, as one contraction
+    return jnp.einsum("iajb,...a,...j,...b->...i", SANDWICH, q, v, q) / jnp.sum(q * q, axis=-1, keepdims=True)
 
 
 def rotate(q: Quaternion, v: Vector) -> Vector:
@@ -389,7 +431,7 @@ def inverse(m: Motion) -> Motion:
 
 def infinitesimal_motion(a: Vector, b: Vector, v: Vector) -> Vector:
     """Cor 3.7: the velocity `½[a, v] + b = a × v + b` of the point v."""
-    return jnp.cross(as_vector(a, "a"), as_vector(v)) + as_vector(b, "b")
+    return _cross(as_vector(a, "a"), as_vector(v)) + as_vector(b, "b")
 
 
 def generator(m: Motion, m_dot: Motion) -> tuple[Vector, Vector]:
@@ -398,7 +440,7 @@ def generator(m: Motion, m_dot: Motion) -> tuple[Vector, Vector]:
     q, p = _as_motion(m, "m")
     q_dot, p_dot = _as_motion(m_dot, "m_dot")
     a = 2 * _mul(q_dot, _inv(q))[..., 1:]
-    return a, p_dot - jnp.cross(a, p)
+    return a, p_dot - _cross(a, p)
 
 
 def motion_ode(a: Vector, b: Vector, m: Motion) -> Motion:
@@ -406,7 +448,7 @@ def motion_ode(a: Vector, b: Vector, m: Motion) -> Motion:
     infinitesimal motion `v ↦ a × v + b` (Section 3.2.1, after Cor 3.7)."""
     q, p = _as_motion(m, "m")
     a, b = as_vector(a, "a"), as_vector(b, "b")
-    return Motion(0.5 * _mul(jnp.concatenate([jnp.zeros_like(a[..., :1]), a], axis=-1), q), b + jnp.cross(a, p))
+    return Motion(0.5 * _mul(jnp.concatenate([jnp.zeros_like(a[..., :1]), a], axis=-1), q), b + _cross(a, p))
 
 
 def _series(x2: Array, coefficients) -> Array:
@@ -435,5 +477,5 @@ def motion_exp(a: Vector, b: Vector, t=1.0) -> Motion:
     c2 = jnp.where(small, t**3 * _series(x2, [1 / 6, -1 / 120, 1 / 5040, -1 / 362880, 1 / 39916800]), (t - jnp.sin(x) / ws) / ws**2)
     c3 = jnp.where(small, t**2 * _series(x2, [1 / 2, -1 / 24, 1 / 720, -1 / 40320, 1 / 3628800]), (1 - jnp.cos(x)) / ws**2)
     ab = jnp.sum(a * b, axis=-1, keepdims=True)
-    p = c1 * b + c2 * ab * a + c3 * jnp.cross(a, b)
+    p = c1 * b + c2 * ab * a + c3 * _cross(a, b)
     return Motion(_exp(0.5 * t * a), p)

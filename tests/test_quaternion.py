@@ -56,6 +56,32 @@ def test_lemma_3_4_product_of_imaginary_quaternions(v, w):
 
 
 @SETTINGS
+@given(vectors, vectors, quaternions)
+def test_cross_and_rotation_are_the_contractions_of_their_structure_constants(v, w, q):
+    """`cross` is Im(vw) (Lemma 3.4) and broadcasts; `rotate` equals the expanded sandwich
+    `((q0² − |u|²) v + 2<u, v> u + 2 q0 u × v) / |q|²`, u = Im q (Prop 3.6) that the
+    contraction with `SANDWICH` replaces."""
+    assert close(qt.cross(v, w), np.cross(v, w))
+    assert close(qt.cross(v, np.stack([w, v, -w])), np.cross(v, np.stack([w, v, -w])))
+    q0, u = q[0], q[1:]
+    expanded = ((q0**2 - u @ u) * v + 2 * (u @ v) * u + 2 * q0 * np.cross(u, v)) / (q @ q)
+    assert close(qt.rotate(q, v), expanded)
+
+
+def test_structure_constants_are_the_tables_of_h_and_r3():
+    """`HAMILTON` has 1 as its unit and e_a e_b = −δ_ab + ε_cab e_c; `LEVI_CIVITA` is
+    antisymmetric with ε_012 = 1; a componentwise check with the sign of k flipped fails."""
+    C, eps = qt.HAMILTON, qt.LEVI_CIVITA
+    assert np.array_equal(C[:, 0, :], np.eye(4)) and np.array_equal(C[:, :, 0], np.eye(4))
+    assert eps[0, 1, 2] == 1 and np.array_equal(eps, -eps.transpose(0, 2, 1))
+    one, i, j, k = np.eye(4)
+    assert close(np.einsum("ijk,j,k->i", C, i, j), k, 0)
+    assert not close(np.einsum("ijk,j,k->i", C, i, j), -k, 0)  # negative control
+    with pytest.raises(ShapeError):
+        qt.cross(np.ones(4), np.ones(3))
+
+
+@SETTINGS
 @given(quaternions, quaternions, quaternions)
 def test_algebra_norm_multiplicative_associative_inverse(p, q, r):
     """|pq| = |p||q|, (pq)r = p(qr), q q⁻¹ = 1, conj(pq) = q̄ p̄."""
