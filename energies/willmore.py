@@ -63,6 +63,7 @@ from ddgjax.errors import InvalidInputError, MeshError
 from ddgjax.laplace import check_nondegenerate, checked_triangle_mesh
 from ddgjax.mesh import boundary_vertices
 from ddgjax.mesh.connectivity import glue_triangles
+from ddgjax.quaternion import cross
 
 from .area import face_area, face_volume
 
@@ -452,7 +453,7 @@ def circle_angle(X: Float[Array, "4 3"], params=None) -> Float[Array, ""]:
     aa = jnp.dot(a, a)
     u = a - b * (aa / jnp.dot(b, b))  # |a|² (j' − k')
     w = c * (aa / jnp.dot(c, c)) - a  # |a|² (l' − j')
-    return jnp.arctan2(_norm(jnp.cross(u, w)), jnp.dot(u, w))
+    return jnp.arctan2(_norm(cross(u, w)), jnp.dot(u, w))
 
 
 def _edge_density(X, offset, params):
