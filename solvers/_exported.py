@@ -21,6 +21,14 @@ The file's name is the SHA-256 of everything the solver's trace reads (`program_
 - the solve's options and the arguments' tree, shapes, dtypes and weak types;
 - the library's own source below its application layer (`APPLICATION`), the versions of JAX
   and of the libraries traced into the solver, the backend and JAX's tracing flags.
+
+Beside each exported program, its compiled executable is kept (`jax.experimental.
+serialize_executable`), under the program's key and `executable_digest()`: the XLA flags, the
+backend's platform version and the host's processor.  A later process with a file for both keys
+loads the executable directly: no export to read, no call to lower, no compilation-cache key to
+compute, only XLA's own deserialisation.  A different flag or machine compiles the exported
+program anew (through the compilation cache) and keeps its executable beside the first.
+
 An input the key cannot describe by value (a Python function, an unknown type) sends the solve
 down the ordinary path (`NotDescribed`): a key that missed an input would return a stale
 program, i.e. a wrong answer.  Only concrete calls on one device are exported (under `jit`,
@@ -37,7 +45,9 @@ import functools
 import hashlib
 import os
 import pickle
+import platform
 import types
+import zlib
 from pathlib import Path
 from typing import Callable
 
@@ -307,13 +317,12 @@ def _exported(impl: functools.partial, treedef, leaves: list, targets: tuple[str
     return exported, out_tree[0]
 
 
-def _store(path: Path, exported=None, out_tree=None) -> None:
-    """Write the program (`NOT_EXPORTABLE` without one) atomically (a partly written file is
-    never read): another process may be reading."""
+def _write(path: Path, body: Callable[[], bytes]) -> None:
+    """Write `FORMAT + body()` to `path` atomically (a partly written file is never read: another
+    process may be reading); a body that cannot be made or written is left unsaved."""
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
     try:
-        body = NOT_EXPORTABLE if exported is None else pickle.dumps((bytes(exported.serialize()), out_tree))
-        data = FORMAT + body
+        data = FORMAT + body()
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp.write_bytes(data)
         os.replace(tmp, path)
@@ -321,20 +330,101 @@ def _store(path: Path, exported=None, out_tree=None) -> None:
         tmp.unlink(missing_ok=True)
 
 
-def _load(path: Path):
-    """`(exported, out_tree)` from `path`, `NOT_EXPORTABLE`, or None if it is absent or unreadable."""
+def _read(path: Path) -> bytes | None:
+    """The body of the file at `path` after `FORMAT`, or None if it is absent or foreign."""
     try:
         data = path.read_bytes()
     except OSError:
         return None
-    if not data.startswith(FORMAT):
-        return None
-    if data[len(FORMAT):] == NOT_EXPORTABLE:
-        return NOT_EXPORTABLE
+    return data[len(FORMAT):] if data.startswith(FORMAT) else None
+
+
+def _store(path: Path, exported=None, out_tree=None) -> None:
+    """Write the program (`NOT_EXPORTABLE` without one)."""
+    _write(path, lambda: NOT_EXPORTABLE if exported is None else pickle.dumps((bytes(exported.serialize()), out_tree)))
+
+
+def _load(path: Path):
+    """`(exported, out_tree)` from `path`, `NOT_EXPORTABLE`, or None if it is absent or unreadable."""
+    body = _read(path)
+    if body is None or body == NOT_EXPORTABLE:
+        return None if body is None else NOT_EXPORTABLE
     try:
-        serialized, out_tree = pickle.loads(data[len(FORMAT):])
+        serialized, out_tree = pickle.loads(body)
         return jax.export.deserialize(bytearray(serialized)), out_tree
     except Exception:  # a truncated or foreign file: export anew and overwrite it
+        return None
+
+
+@functools.lru_cache(maxsize=None)
+def executable_digest() -> str:
+    """What an executable depends on beyond its program's key: the XLA flags of this process,
+    the backend's platform version and the host's processor (its model and instruction set,
+    which XLA:CPU compiles for)."""
+    h = hashlib.sha256(FORMAT)
+    backend = jax.devices()[0].client
+    _feed(h, (os.environ.get("XLA_FLAGS", ""), backend.platform, backend.platform_version, platform.machine()))
+    try:
+        cpu = Path("/proc/cpuinfo").read_text().split("\n\n")[0]  # the first processor's block
+        _feed(h, tuple(line for line in cpu.splitlines() if line.split(":")[0].strip() in ("model name", "flags")))
+    except OSError:
+        _feed(h, platform.processor())
+    return h.hexdigest()[:16]
+
+
+OWN_COMPILATION = {"xla_embed_ir_in_executable": False}
+"""An XLA option at its default value, passed when the exported program's call is compiled to be
+kept: it changes the compilation cache's key only, so that the call is compiled here rather
+than loaded from an entry another path wrote (which could not be kept, `_cache_hits`)."""
+
+_HITS = [0]
+
+
+@functools.lru_cache(maxsize=None)
+def _count_cache_hits() -> None:
+    """Count the compilation cache's hits in `_HITS` from now on (registered once)."""
+
+    def count(event: str, **_) -> None:
+        if event == "/jax/compilation_cache/cache_hits":
+            _HITS[0] += 1
+
+    jax.monitoring.register_event_listener(count)
+
+
+def _cache_hits() -> int:
+    """The compilation cache's hits so far in this process (counted from the first call).
+
+    An executable XLA:CPU loaded from the cache serialises without its compiled kernels (a
+    process that loads it fails with "Function ... not found"), so only an executable compiled
+    in this process is kept."""
+    _count_cache_hits()
+    return _HITS[0]
+
+
+def _store_executable(path: Path, compiled, out_tree) -> None:
+    """Write `compiled` (a `jax.stages.Compiled` of the flat program) serialised and compressed,
+    with the tree of the outputs `out_tree`."""
+    from jax.experimental.serialize_executable import serialize
+
+    _write(path, lambda: zlib.compress(pickle.dumps((*serialize(compiled), out_tree)), 1))
+
+
+def _load_executable(path: Path):
+    """`(compiled, out_tree)` stored at `path`, or None if it is absent or unreadable."""
+    from jax.experimental.serialize_executable import deserialize_and_load
+
+    body = _read(path)
+    if body is None:
+        return None
+    try:
+        # LAPACK's kernels (LU, eigh) are bound when JAX lowers a call to them, which a loaded
+        # program skips: bind them now, or the program calls null pointers
+        from jax._src.lax.linalg import initialize_lapack
+
+        initialize_lapack()
+        payload, in_tree, flat_out_tree, out_tree = pickle.loads(zlib.decompress(body))
+        return deserialize_and_load(payload, in_tree, flat_out_tree, execution_devices=jax.devices()[:1]), out_tree
+    except Exception:  # truncated (zlib's checksum), foreign, or from another JAX: compile anew
         return None
 
 
@@ -389,6 +479,10 @@ class Program:
             return None
         path = folder / f"{key}.program"
         targets = ffi_targets()  # registered before a loaded program calls them
+        executable = folder / f"{key}-{executable_digest()}.executable"
+        stored = _load_executable(executable)
+        if stored is not None:
+            return _unflattened(*stored)
         loaded = _load(path)
         if loaded is None:
             try:
@@ -400,12 +494,20 @@ class Program:
         if loaded is NOT_EXPORTABLE:
             return None
         exported, out_tree = loaded
-        run = jax.jit(exported.call)
-        return lambda flat: jax.tree_util.tree_unflatten(out_tree, run(*flat))
+        hits = _cache_hits()
+        compiled = jax.jit(exported.call, compiler_options=OWN_COMPILATION).lower(*avals).compile()
+        if _cache_hits() == hits:  # compiled here, not loaded: XLA serialises only what it compiled
+            _store_executable(executable, compiled, out_tree)
+        return _unflattened(compiled, out_tree)
 
     def _cache_size(self) -> int:
         """Executables held: the jitted function's and one per exported signature."""
         return self.jitted._cache_size() + sum(call is not None for call in self.calls.values())
+
+
+def _unflattened(compiled, out_tree) -> Callable:
+    """The flat program `compiled` as a function of the flat arguments returning the outputs' tree."""
+    return lambda flat: jax.tree_util.tree_unflatten(out_tree, compiled(*flat))
 
 
 def programs(fn: Callable, size: int = 32) -> Callable:

@@ -9,6 +9,8 @@ their own solution, a second "process" (JAX's caches cleared) loads the program 
 tracing it, and a corrupt file is replaced.
 """
 
+import time
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -150,15 +152,39 @@ def test_declarations_alike_but_for_a_constant_get_their_own_solutions(folder):
     assert len(list(folder.glob("*.program"))) == 2
 
 
-def test_a_new_process_loads_the_program_without_tracing_the_solver(folder):
-    problem = clamped(14)
+def unseen() -> dg.Problem:
+    """A quadratic whose target has a constant unique to this run: JAX's compilation cache,
+    shared by the suite's runs, cannot hold its program, which this process compiles."""
+    return quadratic(target=TARGET + time.time_ns() % 10**9 * 1e-12)
+
+
+def test_a_new_process_loads_the_executable_without_tracing_or_lowering_the_solver(folder):
+    problem = unseen()
     first, names = lowered(lambda: solve(problem))
-    assert "jit(_solve_impl)" in names
+    assert "jit(_solve_impl)" in names and "jit(call)" in names  # exported, then its call compiled
+    (executable,) = folder.glob("*.executable")
+    assert executable.name.endswith(f"-{_exported.executable_digest()}.executable")
     jax.clear_caches()
-    second, names = lowered(lambda: solve(clamped(14)))
-    assert "jit(_solve_impl)" not in names and "jit(call)" in names
+    second, names = lowered(lambda: solve(problem))
+    assert "jit(_solve_impl)" not in names and "jit(call)" not in names
     for a, b in zip(jax.tree_util.tree_leaves(first), jax.tree_util.tree_leaves(second), strict=True):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+
+
+def test_a_corrupt_executable_falls_back_to_the_exported_program(folder):
+    """A truncated executable (or one for other XLA flags: another `executable_digest`) is not
+    loaded: the exported program's call is lowered (the solver is not traced again) and loaded
+    from the compilation cache.  An executable loaded from that cache is not written over the
+    file: XLA:CPU serialises it without its kernels."""
+    problem = unseen()
+    first = solve(problem)
+    (executable,) = folder.glob("*.executable")
+    executable.write_bytes(_exported.FORMAT + b"truncated")
+    jax.clear_caches()
+    second, names = lowered(lambda: solve(problem))
+    assert "jit(_solve_impl)" not in names and "jit(call)" in names
+    assert _exported._load_executable(executable) is None
+    np.testing.assert_array_equal(np.asarray(first.x), np.asarray(second.x))
 
 
 def test_a_corrupt_file_is_exported_anew(folder):
