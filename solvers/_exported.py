@@ -27,7 +27,10 @@ serialize_executable`), under the program's key and `executable_digest()`: the X
 backend's platform version and the host's processor.  A later process with a file for both keys
 loads the executable directly: no export to read, no call to lower, no compilation-cache key to
 compute, only XLA's own deserialisation.  A different flag or machine compiles the exported
-program anew (through the compilation cache) and keeps its executable beside the first.
+program anew (through the compilation cache) and keeps its executable beside the first.  An
+executable XLA:CPU loaded from the compilation cache serialises without its kernels, so a
+process that finds the call there (its executable removed) compiles it once more, outside
+that cache, to keep it (`_compiled_here`).
 
 An input the key cannot describe by value (a Python function, an unknown type) sends the solve
 down the ordinary path (`NotDescribed`): a key that missed an input would return a stale
@@ -47,6 +50,7 @@ import os
 import pickle
 import platform
 import types
+import uuid
 import zlib
 from pathlib import Path
 from typing import Callable
@@ -374,8 +378,8 @@ def executable_digest() -> str:
 
 OWN_COMPILATION = {"xla_embed_ir_in_executable": False}
 """An XLA option at its default value, passed when the exported program's call is compiled to be
-kept: it changes the compilation cache's key only, so that the call is compiled here rather
-than loaded from an entry another path wrote (which could not be kept, `_cache_hits`)."""
+kept: it changes the compilation cache's key only, so that the call is not found under an entry
+another path wrote (which could not be kept, `_cache_hits`)."""
 
 _HITS = [0]
 
@@ -399,6 +403,22 @@ def _cache_hits() -> int:
     in this process is kept."""
     _count_cache_hits()
     return _HITS[0]
+
+
+def _compiled_here(call: Callable, avals: tuple):
+    """`call` at `avals` compiled in this process, bypassing JAX's compilation cache: under a
+    module name of its own (the cache's key includes it) and not written there.  The
+    executable of a program whose compilation-cache entry outlived its kept executable (a file
+    removed, or written by an older library) is thus kept again once, not loaded from the cache
+    in every later process."""
+    from jax._src import config
+
+    def fresh(*args):
+        return call(*args)
+
+    fresh.__name__ = fresh.__qualname__ = f"call_{uuid.uuid4().hex}"
+    with config.persistent_cache_min_compile_time_secs(float("inf")):
+        return jax.jit(fresh, compiler_options=OWN_COMPILATION).lower(*avals).compile()
 
 
 def _store_executable(path: Path, compiled, out_tree) -> None:
@@ -496,8 +516,9 @@ class Program:
         exported, out_tree = loaded
         hits = _cache_hits()
         compiled = jax.jit(exported.call, compiler_options=OWN_COMPILATION).lower(*avals).compile()
-        if _cache_hits() == hits:  # compiled here, not loaded: XLA serialises only what it compiled
-            _store_executable(executable, compiled, out_tree)
+        if _cache_hits() != hits:  # loaded from JAX's cache, which XLA:CPU cannot serialise again
+            compiled = _compiled_here(exported.call, avals)
+        _store_executable(executable, compiled, out_tree)
         return _unflattened(compiled, out_tree)
 
     def _cache_size(self) -> int:

@@ -171,26 +171,38 @@ def test_a_new_process_loads_the_executable_without_tracing_or_lowering_the_solv
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
 
 
-def test_a_corrupt_executable_falls_back_to_the_exported_program(folder):
+def test_a_corrupt_or_missing_executable_is_compiled_here_and_kept_again(folder):
     """A truncated executable (or one for other XLA flags: another `executable_digest`) is not
-    loaded: the exported program's call is lowered (the solver is not traced again) and loaded
-    from the compilation cache.  An executable loaded from that cache is not written over the
-    file: XLA:CPU serialises it without its kernels."""
+    loaded: the exported program's call is lowered (the solver is not traced again).  Its entry
+    in JAX's compilation cache cannot be kept (XLA:CPU serialises a loaded executable without
+    its kernels), so the call is compiled once more here, outside that cache, and kept: the
+    next process loads it without lowering anything.  The same holds for a removed file."""
     problem = unseen()
     first = solve(problem)
     (executable,) = folder.glob("*.executable")
-    executable.write_bytes(_exported.FORMAT + b"truncated")
-    jax.clear_caches()
-    second, names = lowered(lambda: solve(problem))
-    assert "jit(_solve_impl)" not in names and "jit(call)" in names
-    assert _exported._load_executable(executable) is None
-    np.testing.assert_array_equal(np.asarray(first.x), np.asarray(second.x))
+    for damage in (lambda: executable.write_bytes(_exported.FORMAT + b"truncated"), executable.unlink):
+        damage()
+        jax.clear_caches()
+        second, names = lowered(lambda: solve(problem))
+        assert "jit(_solve_impl)" not in names and "jit(call)" in names
+        assert any(name.startswith("jit(call_") for name in names)  # compiled here, under a name of its own
+        assert _exported._load_executable(executable) is not None
+        jax.clear_caches()
+        third, names = lowered(lambda: solve(problem))
+        assert "jit(_solve_impl)" not in names and "jit(call)" not in names and not names
+        for a, b, c in zip(*map(jax.tree_util.tree_leaves, (first, second, third)), strict=True):
+            np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+            np.testing.assert_array_equal(np.asarray(a), np.asarray(c))
 
 
 def test_a_corrupt_file_is_exported_anew(folder):
+    """A corrupt exported program (its executable gone: otherwise that is loaded, and the
+    program never read) is exported again."""
     solve(quadratic())
     (path,) = folder.glob("*.program")
     path.write_bytes(_exported.FORMAT + b"not a pickle")
+    for executable in folder.glob("*.executable"):
+        executable.unlink()
     jax.clear_caches()
     sol = solve(quadratic())
     np.testing.assert_allclose(np.asarray(sol.x), TARGET, atol=1e-12)
