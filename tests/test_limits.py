@@ -62,6 +62,33 @@ def test_convergence_plot_shows_the_table(tmp_path):
     assert plt.imread(path).shape == (420, 540, 4)  # 4.5 × 3.5 in at 120 dpi
 
 
+def test_convergence_plot_ticks_the_resolutions(tmp_path):
+    """The n axis is ticked at the table's resolutions, labelled "16" … "1024"; an error axis
+    spanning two decades or more has only its decades (no minor ticks), a narrower one keeps
+    matplotlib's labelled minor ticks.  Negative control: a plain log-log axes has minor ticks."""
+    import matplotlib.pyplot as plt
+
+    ns = [16, 32, 64, 128, 256, 512, 1024]
+    wide = dg.limits.ConvergenceTable.from_errors(np.array(ns), 3.0 / np.array(ns, dtype=float) ** 2)
+    fig = dg.plot.convergence(wide)
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    np.testing.assert_array_equal(ax.get_xticks(), ns)
+    assert [t.get_text() for t in ax.get_xticklabels()] == [str(n) for n in ns]
+    assert len(ax.xaxis.get_minorticklocs()) == 0 and len(ax.yaxis.get_minorticklocs()) == 0
+    plt.close(fig)
+    narrow = dg.limits.ConvergenceTable.from_errors(np.array([8, 16, 32]), np.array([1.1e-3, 1.0e-3, 0.95e-3]))
+    fig = dg.plot.convergence(narrow)
+    fig.canvas.draw()
+    assert any(t.get_text() for t in fig.axes[0].yaxis.get_minorticklabels())
+    plt.close(fig)
+    fig, ax = plt.subplots()
+    ax.loglog(wide.ns, wide.errors)
+    fig.canvas.draw()
+    assert len(ax.yaxis.get_minorticklocs()) > 0
+    plt.close(fig)
+
+
 def test_observed_orders_exact_power_law():
     ns = np.array([10, 20, 40])
     table = dg.limits.ConvergenceTable.from_errors(ns, 3.0 * ns**-1.5)

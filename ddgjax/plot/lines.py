@@ -82,6 +82,27 @@ def curves(
     return _finish(ax, path)
 
 
+def _ticks_at(axis, values) -> None:
+    """Ticks of `axis` at `values` only, labelled as plain numbers ("16", "1024"): for the
+    resolutions of a convergence table these say more than a log axis's decades, and matplotlib
+    draws no minor ticks (on a log axis, most of the time of drawing a small figure)."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+    axis.set_major_locator(FixedLocator(np.asarray(values, dtype=float)))
+    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.set_minor_locator(NullLocator())
+
+
+def _decades_only(axis, values) -> None:
+    """No minor ticks on the log `axis` when `values` span two powers of ten or more (their
+    decades label it; matplotlib would draw eight unlabelled minor ticks per decade)."""
+    from matplotlib.ticker import NullLocator
+
+    positive = np.asarray(values)[np.asarray(values) > 0]
+    if positive.size and np.floor(np.log10(positive.max())) - np.ceil(np.log10(positive.min())) >= 1:
+        axis.set_minor_locator(NullLocator())
+
+
 CONVERGENCE_MARGINS = dict(left=0.2, right=0.96, bottom=0.14, top=0.9)
 """The axes of `convergence` in figure fractions: room for log tick labels and one-line labels."""
 
@@ -89,7 +110,8 @@ CONVERGENCE_MARGINS = dict(left=0.2, right=0.96, bottom=0.14, top=0.9)
 def convergence(table: ConvergenceTable, path=None, *, title: str | None = None):
     """Log-log plot of a `ddgjax.limits.ConvergenceTable`: one 2-D axes with the errors against n
     (points joined, labelled `table.label`) and a dashed reference line of slope −p through the
-    first error, p the fitted order; a legend, and the title `title` or "fitted order p".
+    first error, p the fitted order; a legend, and the title `title` or "fitted order p".  The
+    n axis is ticked and labelled at the table's resolutions.
 
     Returns the figure, or `path` after saving there (= `table.plot(path)`).
     """
@@ -97,6 +119,8 @@ def convergence(table: ConvergenceTable, path=None, *, title: str | None = None)
     ax.loglog(table.ns, table.errors, "o-", label=table.label)
     reference = table.errors[0] * (table.ns / table.ns[0]) ** (-table.fitted_order)
     ax.loglog(table.ns, reference, "--", color="gray", label=f"slope −{table.fitted_order:.2f}")
+    _ticks_at(ax.xaxis, table.ns)  # after the last loglog, which sets the axis's scale and locators anew
+    _decades_only(ax.yaxis, np.concatenate([table.errors, reference]))
     ax.set_xlabel("n")
     ax.set_ylabel(table.label)
     # y given: the title sits at the top of the axes, where matplotlib would place it anyway (no
