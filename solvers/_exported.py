@@ -376,11 +376,6 @@ def executable_digest() -> str:
     return h.hexdigest()[:16]
 
 
-OWN_COMPILATION = {"xla_embed_ir_in_executable": False}
-"""An XLA option at its default value, passed when the exported program's call is compiled to be
-kept: it changes the compilation cache's key only, so that the call is not found under an entry
-another path wrote (which could not be kept, `_cache_hits`)."""
-
 _HITS = [0]
 
 
@@ -399,8 +394,8 @@ def _cache_hits() -> int:
     """The compilation cache's hits so far in this process (counted from the first call).
 
     An executable XLA:CPU loaded from the cache serialises without its compiled kernels (a
-    process that loads it fails with "Function ... not found"), so only an executable compiled
-    in this process is kept."""
+    process that loads it fails with "Function ... not found"): one found there is compiled once
+    more in this process (`_compiled_here`) to be kept."""
     _count_cache_hits()
     return _HITS[0]
 
@@ -418,7 +413,7 @@ def _compiled_here(call: Callable, avals: tuple):
 
     fresh.__name__ = fresh.__qualname__ = f"call_{uuid.uuid4().hex}"
     with config.persistent_cache_min_compile_time_secs(float("inf")):
-        return jax.jit(fresh, compiler_options=OWN_COMPILATION).lower(*avals).compile()
+        return jax.jit(fresh).lower(*avals).compile()
 
 
 def _store_executable(path: Path, compiled, out_tree) -> None:
@@ -515,7 +510,7 @@ class Program:
             return None
         exported, out_tree = loaded
         hits = _cache_hits()
-        compiled = jax.jit(exported.call, compiler_options=OWN_COMPILATION).lower(*avals).compile()
+        compiled = jax.jit(exported.call).lower(*avals).compile()
         if _cache_hits() != hits:  # loaded from JAX's cache, which XLA:CPU cannot serialise again
             compiled = _compiled_here(exported.call, avals)
         _store_executable(executable, compiled, out_tree)
